@@ -1,0 +1,15 @@
+#pragma once
+// The subcommands of `ranging`. Each lives in tool/cmd_<name>.cpp, takes the arguments
+// after its name and returns the process exit status (InputError propagates: status 2).
+#include <string>
+#include <vector>
+
+namespace ranging::tool {
+
+using Args = std::vector<std::string>;
+
+int cmd_codes(const Args& args);   // code families (cmd_codes.cpp)
+int cmd_filter(const Args& args);  // bandpass filter design (cmd_filter.cpp)
+int cmd_demo(const Args& args);    // encode, channel, filter, decode every code (cmd_demo.cpp)
+
+}  // namespace ranging::tool

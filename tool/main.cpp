@@ -1,0 +1,65 @@
+// `ranging`: the command-line front end of the golden model.
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "model/error.hpp"
+#include "tool/commands.hpp"
+
+namespace {
+
+struct Subcommand {
+  const char* name;
+  const char* summary;
+  int (*run)(const ranging::tool::Args&);
+};
+
+constexpr Subcommand kSubcommands[] = {
+    {"demo", "encode every code of a family, send it through a channel, decode it (float and fixed)",
+     ranging::tool::cmd_demo},
+    {"codes", "list code families, print their codes (M-sequences, Gold codes)",
+     ranging::tool::cmd_codes},
+    {"filter", "design the bandpass filter; print sections and quantized coefficients",
+     ranging::tool::cmd_filter},
+};
+
+void print_usage(std::ostream& os) {
+  os << "usage: ranging <command> [options]    (ranging <command> --help for details)\n\n"
+        "Coded ultrasonic ranging co-design toolkit (Lu et al., Micromachines 2025, 16, 240).\n\n"
+        "commands:\n";
+  for (const Subcommand& c : kSubcommands) {
+    os << "  " << c.name << std::string(10 - std::string(c.name).size(), ' ') << c.summary << "\n";
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    print_usage(std::cerr);
+    return 2;
+  }
+  if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    print_usage(std::cout);
+    return 0;
+  }
+  for (const Subcommand& c : kSubcommands) {
+    if (args[0] == c.name) {
+      try {
+        return c.run({args.begin() + 1, args.end()});
+      } catch (const ranging::InputError& e) {
+        std::cerr << "ranging " << c.name << ": error: " << e.what() << "\n";
+        return 2;
+      } catch (const std::exception& e) {
+        std::cerr << "ranging " << c.name << ": internal error: " << e.what() << "\n";
+        return 1;
+      }
+    }
+  }
+  std::cerr << "ranging: unknown command '" << args[0] << "'\n\n";
+  print_usage(std::cerr);
+  return 2;
+}
