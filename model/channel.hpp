@@ -3,9 +3,9 @@
 //   y[k] = g * (0.1 m / d) * RX(TX(x))(k/fs - d/c) + w[k]
 // x is the excitation sent at sample 0; TX and RX are resonant transducers
 // (transducer.hpp); the propagation delay d/c is applied exactly by a 64-tap
-// Kaiser-windowed-sinc fractional-delay interpolator (delay error < 1e-6 sample for the
-// 200 kHz band at 5 MS/s, docs/signal-model.md); the gain follows spherical spreading 1/d
-// from a 0.1 m reference; w is white Gaussian noise (std::mt19937_64 +
+// Kaiser-windowed-sinc fractional-delay interpolator (delay error < 1e-5 sample and gain
+// error < 4e-6 from 100 kHz to 2 MHz at 5 MS/s, docs/signal-model.md); the gain follows
+// spherical spreading 1/d from a 0.1 m reference; w is white Gaussian noise (std::mt19937_64 +
 // std::normal_distribution, deterministic for a given seed with this libstdc++).
 // Absent in the model: absorption, multipath, turbulence, transducer directivity.
 #include <cstddef>
