@@ -1,0 +1,108 @@
+#pragma once
+// Bit-accurate fixed-point arithmetic of the golden model: the rules the generated hardware
+// implements, proven bit for bit against SystemC's sc_fix / sc_fixed
+// (tests/test_fixed_point_vs_systemc.cpp). See docs/fixed-point.md.
+//
+// A format is runtime configuration (word lengths are swept by later tools):
+//   value = raw * 2^-frac,  raw a two's complement (or unsigned) integer of `width` bits.
+// Arithmetic is exact: +, -, * return a FixedWide whose format grows so that no bit is lost
+// (add/sub: max integer bits + 1, mul: sum of widths). The only place where bits are dropped
+// is fixed_cast / fx_quantize, which applies the target format's rounding (on the dropped
+// fraction bits) and then its overflow rule (on the dropped integer bits), exactly like a
+// SystemC cast: quantize first, then overflow.
+#include <cstdint>
+#include <string>
+
+namespace ranging {
+
+// GCC/Clang extension; the exact products of two 64-bit words need it.
+__extension__ typedef __int128 int128_t;
+__extension__ typedef unsigned __int128 uint128_t;
+static_assert(sizeof(int128_t) == 16, "ranging needs a compiler with __int128 (GCC or Clang)");
+
+enum class Rounding {
+  Truncate,     // floor toward -inf: drop the bits (SystemC SC_TRN)
+  RoundHalfUp,  // add half an LSB, then floor: ties toward +inf (SC_RND)
+  Convergent,   // round to nearest, ties to even (SC_RND_CONV)
+};
+enum class Overflow {
+  Wrap,      // keep the low `width` bits (SC_WRAP)
+  Saturate,  // clamp to the most negative / most positive code (SC_SAT)
+};
+
+struct FixedFormat {
+  int width = 16;  // 2..64 signed, 2..63 unsigned (the raw value is held in an int64)
+  int frac = 15;   // may be negative or larger than width; |frac| <= kMaxFrac
+  bool is_signed = true;
+  Rounding rounding = Rounding::Truncate;
+  Overflow overflow = Overflow::Wrap;
+};
+
+constexpr int kMaxFrac = 1024;
+
+// Throws InputError naming `field` and the valid range unless the format is representable.
+void validate(const FixedFormat& fmt, const std::string& field);
+
+// Smallest and largest raw code of a format.
+std::int64_t fx_min_raw(const FixedFormat& fmt);
+std::int64_t fx_max_raw(const FixedFormat& fmt);
+
+// Overflow events are counted, never hidden. A counter may be shared by many casts.
+struct OverflowCounter {
+  std::uint64_t saturations = 0;
+  std::uint64_t wraps = 0;
+  std::uint64_t total() const { return saturations + wraps; }
+};
+
+// Quantize raw * 2^-src_frac into fmt: round away the surplus fraction bits by fmt.rounding,
+// then bring the result into fmt's range by fmt.overflow, counting an overflow event in
+// *counter (may be null). src_frac may be any int (negative = integer bits below the LSB).
+// The format is not validated here (hot path); validate it once beforehand.
+std::int64_t fx_quantize(int128_t raw, int src_frac, const FixedFormat& fmt, OverflowCounter* counter);
+
+// An exact intermediate result (up to 128 bits): what +, -, * of Fixed values give.
+// It has no rounding/overflow rule of its own; fixed_cast applies the target's.
+struct FixedWide {
+  int128_t raw = 0;
+  int width = 2;  // bits needed for any result of the operation that produced it (<= 128)
+  int frac = 0;
+  bool is_signed = true;
+  double to_double() const;
+};
+
+class Fixed {
+ public:
+  // Zero in a default format (Q1.15 signed, truncate, wrap).
+  Fixed() = default;
+  // The double is quantized by fmt's rounding and overflow rules (an overflow is counted).
+  // Throws InputError if fmt is invalid or value is not finite.
+  explicit Fixed(double value, const FixedFormat& fmt, OverflowCounter* counter = nullptr);
+  // Takes raw as is; throws InputError if it is outside fmt's range.
+  static Fixed from_raw(std::int64_t raw, const FixedFormat& fmt);
+
+  std::int64_t raw() const { return raw_; }
+  const FixedFormat& format() const { return fmt_; }
+  double to_double() const;
+  FixedWide wide() const;  // the same value as a FixedWide (no growth)
+
+ private:
+  friend Fixed fixed_cast(const FixedWide& x, const FixedFormat& fmt, OverflowCounter* counter);
+  std::int64_t raw_ = 0;
+  FixedFormat fmt_{};
+};
+
+// Exact operations. The result format is signed if either operand is signed (sub: always),
+// with frac = max of the fracs (add/sub) or sum (mul). Throws std::overflow_error if the
+// exact result would need more than 128 bits (e.g. adding values whose fracs differ by ~100).
+FixedWide operator+(const FixedWide& a, const FixedWide& b);
+FixedWide operator-(const FixedWide& a, const FixedWide& b);
+FixedWide operator*(const FixedWide& a, const FixedWide& b);
+inline FixedWide operator+(const Fixed& a, const Fixed& b) { return a.wide() + b.wide(); }
+inline FixedWide operator-(const Fixed& a, const Fixed& b) { return a.wide() - b.wide(); }
+inline FixedWide operator*(const Fixed& a, const Fixed& b) { return a.wide() * b.wide(); }
+
+// The one lossy step: round then overflow into fmt (validated; throws InputError if invalid).
+Fixed fixed_cast(const FixedWide& x, const FixedFormat& fmt, OverflowCounter* counter = nullptr);
+Fixed fixed_cast(const Fixed& x, const FixedFormat& fmt, OverflowCounter* counter = nullptr);
+
+}  // namespace ranging
