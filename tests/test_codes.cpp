@@ -189,6 +189,9 @@ TEST(PaperTables, ReciprocalFamiliesAreTimeReversals) {
   Code r = ranging::code_family("M1").codes[0];
   std::reverse(r.begin(), r.end());
   EXPECT_EQ(r, ranging::code_family("M2").codes[3]);
+  r = ranging::code_family("M3").codes[0];
+  std::reverse(r.begin(), r.end());
+  EXPECT_EQ(r, ranging::code_family("M4").codes[4]);
 }
 
 // The paper's bases come straight out of msequence() (phase: first chips 1, 0, ..., 0, 1).
