@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the project needs, only those that are missing.
+# Usage: scripts/install-deps.sh [--hardware]   (--hardware adds the FPGA/HDL tools)
+set -euo pipefail
+
+packages=(build-essential cmake g++ libgtest-dev libgmock-dev libbenchmark-dev libsystemc-dev
+          nlohmann-json3-dev libyaml-cpp-dev python3 python3-numpy python3-scipy python3-matplotlib)
+if [[ "${1:-}" == "--hardware" ]]; then
+  packages+=(verilator iverilog yosys nextpnr-ice40 fpga-icestorm gtkwave)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}" >&2
+sudo=""
+if [[ $(id -u) -ne 0 ]]; then
+  command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  sudo="sudo"
+fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

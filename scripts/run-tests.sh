@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# The whole test suite: install what is missing, build, run ctest.
+# With CI=true: warnings are errors, and the suite runs a second time in an ASan+UBSan build.
+# Tests labelled "soak" (minutes long) are skipped unless RANGING_SOAK=1.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+"$root/scripts/install-deps.sh" --hardware
+jobs=$(nproc)
+exclude=()
+[[ "${RANGING_SOAK:-0}" == "1" ]] || exclude=(-LE soak)
+
+echo "== build (Release) =="
+"$root/scripts/build.sh" "$root/build"
+echo "== tests (Release) =="
+ctest --test-dir "$root/build" --output-on-failure -j"$jobs" "${exclude[@]}"
+
+if [[ "${CI:-}" == "true" || "${RANGING_SANITIZE:-0}" == "1" ]]; then
+  echo "== build (ASan+UBSan) =="
+  "$root/scripts/build.sh" "$root/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DRANGING_SANITIZE=ON -DRANGING_BUILD_BENCH=OFF
+  echo "== tests (ASan+UBSan) =="
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir "$root/build-asan" --output-on-failure -j"$jobs" "${exclude[@]}"
+fi
