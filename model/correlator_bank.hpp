@@ -31,7 +31,7 @@ namespace ranging {
 // Word lengths of the fixed-point correlator bank. Input y is signed data_bits with data_frac
 // fraction bits (the bandpass output).
 struct CorrelatorFixedConfig {
-  int data_bits = 16, data_frac = 15;  // input y (from the bandpass filter)
+  int data_bits = 16, data_frac = 14;  // input y (the bandpass output, Q2.14)
   int lo_bits = 16;                    // LO table: round((2^(lo_bits-1)-1) * cos|sin), signed
   int mix_bits = 18;                   // mixer output B: signed, same integer bits as y;
                                        // round half up, saturate (cannot happen; counted)
