@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
+#include <utility>
 
 #include "model/error.hpp"
 
@@ -55,6 +57,14 @@ std::vector<double> propagate(std::span<const double> excitation, const ChannelP
   require_in_range("n_out", static_cast<double>(n_out), 0.0, 1e8);
   for (std::size_t i = 0; i < excitation.size(); ++i) {
     require_finite("excitation[" + std::to_string(i) + "]", excitation[i]);
+  }
+  // Name which transducer is wrong: the shared validator does not know.
+  for (const auto& [name, tp] : {std::pair{"tx", &p.tx}, std::pair{"rx", &p.rx}}) {
+    try {
+      validate(*tp, fs);
+    } catch (const InputError& e) {
+      throw InputError(std::string(name) + ": " + e.what());
+    }
   }
   Transducer tx(p.tx, fs), rx(p.rx, fs);
 

@@ -6,6 +6,7 @@
 #include <complex>
 #include <cstdint>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "model/channel.hpp"
@@ -241,7 +242,12 @@ TEST(Channel, RefusesBadParameters) {
   EXPECT_THROW(validate(p), InputError);
   p = {};
   p.rx.centre_hz = 3e6;
-  EXPECT_THROW(propagate(x, p, kFs, 100), InputError);
+  try {
+    propagate(x, p, kFs, 100);
+    FAIL() << "rx centre above Nyquist accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("rx: transducer centre_hz", 0), 0u) << e.what();
+  }
   EXPECT_THROW(propagate(x, ChannelParams{}, 0.0, 100), InputError);
 }
 
