@@ -490,7 +490,13 @@ SosFilter design_bandpass(const BandpassSpec& spec, FilterType type, int order) 
 }
 
 SosFilter design_bandpass(const BandpassSpec& spec, FilterType type) {
-  return design_bandpass(spec, type, minimum_order(spec, type));
+  const int order = minimum_order(spec, type);
+  if (order > kMaxFilterOrder) {
+    throw InputError("fs1, fp1, fp2, fs2, rp_db, rs_db: the spec needs a " + filter_type_name(type) +
+                     " prototype of order " + std::to_string(order) + ", more than the maximum " +
+                     std::to_string(kMaxFilterOrder) + "; widen the transition bands or relax rp/rs");
+  }
+  return design_bandpass(spec, type, order);
 }
 
 FilterType parse_filter_type(std::string_view name) {

@@ -294,6 +294,12 @@ TEST(FilterDesign, InfeasibleSpecsAreRefused) {
   s = {};
   s.fs = -1;
   expect_input_error(s, "fs");
+  // Feasible in principle, but beyond the maximum order: refused, naming the spec.
+  s = {};
+  s.fs1 = 149e3;
+  s.rs_db = 200;
+  EXPECT_GT(minimum_order(s, FilterType::Butterworth), kMaxFilterOrder);
+  expect_input_error(s, "rs_db");
   EXPECT_THROW(design_bandpass(BandpassSpec{}, FilterType::Elliptic, 0), InputError);
   EXPECT_THROW(design_bandpass(BandpassSpec{}, FilterType::Elliptic, kMaxFilterOrder + 1),
                InputError);
@@ -380,6 +386,7 @@ TEST(FilterCli, BadSpecsExitTwoNamingTheOption) {
   expect_cli_error("--fs nan", "--fs");
   expect_cli_error("--type cheby2", "--type");
   expect_cli_error("--order 21", "--order");
+  expect_cli_error("--fs1 149000 --rs 200", "--rs");
   // a1 is about -1.8: it does not fit 4 bits with 3 fraction bits ([-1, 0.875]).
   expect_cli_error("--coef-bits 4 --coef-frac 3 --json", "--coef-bits");
 }

@@ -89,11 +89,11 @@ int cmd_filter(const Args& args) {
   std::vector<double> wn;
   try {
     validate(spec);
-    const int order = p.has("--order")
-                          ? static_cast<int>(p.integer("--order", 0, 1, kMaxFilterOrder))
-                          : minimum_order(spec, type);
-    filter = design_bandpass(spec, type, order);
-    wn = natural_frequencies(spec, type, order);
+    filter = p.has("--order")
+                 ? design_bandpass(spec, type,
+                                   static_cast<int>(p.integer("--order", 0, 1, kMaxFilterOrder)))
+                 : design_bandpass(spec, type);
+    wn = natural_frequencies(spec, type, filter.order);
   } catch (const InputError& e) {
     rethrow_as_option(e);
   }
