@@ -9,16 +9,18 @@ namespace ranging {
 namespace {
 
 template <class T>
-void best_two(const std::vector<T>& p, int& best, T& second) {
+void best_two(const std::vector<T>& q, int& best, T& second) {
   best = 0;
-  for (int j = 1; j < static_cast<int>(p.size()); ++j) {
-    if (p[j] > p[best]) best = j;
+  for (int j = 1; j < static_cast<int>(q.size()); ++j) {
+    if (q[j] > q[best]) best = j;
   }
   second = T{};
-  for (int j = 0; j < static_cast<int>(p.size()); ++j) {
-    if (j != best && p[j] > second) second = p[j];
+  for (int j = 0; j < static_cast<int>(q.size()); ++j) {
+    if (j != best && q[j] > second) second = q[j];
   }
 }
+
+}  // namespace
 
 void validate(const DetectorConfig& cfg) {
   require_in_range("detector.threshold", cfg.threshold, 0.0, 1.0);
@@ -26,8 +28,6 @@ void validate(const DetectorConfig& cfg) {
   require_in_range("detector.frac_bits", cfg.frac_bits, 0, 16);
   if (cfg.holdoff != -1) require_in_range("detector.holdoff", cfg.holdoff, 1, 1 << 24);
 }
-
-}  // namespace
 
 Event EventFixed::to_float(int frac_bits, int score_bits) const {
   Event e;
@@ -38,25 +38,24 @@ Event EventFixed::to_float(int frac_bits, int score_bits) const {
   return e;
 }
 
-std::int64_t parabolic_fraction(std::int64_t p_prev, std::int64_t p, std::int64_t p_next,
+std::int64_t parabolic_fraction(std::uint64_t q_prev, std::uint64_t q, std::uint64_t q_next,
                                 int frac_bits) {
-  const std::int64_t den = 2 * (2 * p - p_prev - p_next);
+  const int128_t den = 2 * (2 * static_cast<int128_t>(q) - q_prev - q_next);
   if (den <= 0) return 0;
-  const __int128 num = static_cast<__int128>(p_next - p_prev) * (std::int64_t{1} << frac_bits);
-  std::int64_t q = static_cast<std::int64_t>(num / den);  // truncates toward zero
+  const int128_t num = (static_cast<int128_t>(q_next) - q_prev) * (int128_t{1} << frac_bits);
   const std::int64_t half = frac_bits > 0 ? (std::int64_t{1} << (frac_bits - 1)) : 0;
-  return std::clamp(q, -half, half);
+  const int128_t r = num / den;  // truncates toward zero
+  return static_cast<std::int64_t>(std::clamp<int128_t>(r, -half, half));
 }
 
 // ---------------------------------------------------------------------------------------
 
-PeakDetectorFloat::PeakDetectorFloat(const DetectorConfig& cfg, int code_window_samples)
-    : cfg_(cfg), holdoff_(cfg.holdoff == -1 ? code_window_samples : cfg.holdoff) {
+PeakDetectorFloat::PeakDetectorFloat(const DetectorConfig& cfg, const CorrelatorReference& ref)
+    : cfg_(cfg), holdoff_(cfg.holdoff == -1 ? ref.window : cfg.holdoff), decimation_(ref.decimation) {
   validate(cfg);
 }
 
 void PeakDetectorFloat::reset() {
-  n_ = 0;
   prev_.clear();
   cand_.reset();
 }
@@ -64,44 +63,43 @@ void PeakDetectorFloat::reset() {
 Event PeakDetectorFloat::make_event(const Candidate& c) const {
   Event e;
   e.code = c.code + 1;
-  const double den = 2.0 * (2.0 * c.p - c.p_prev - c.p_next);
-  const double delta = den > 0 ? std::clamp((c.p_next - c.p_prev) / den, -0.5, 0.5) : 0.0;
-  e.arrival = static_cast<double>(c.n) + delta;
+  const double den = 2.0 * (2.0 * c.q - c.q_prev - c.q_next);
+  const double delta = den > 0 ? std::clamp((c.q_next - c.q_prev) / den, -0.5, 0.5) : 0.0;
+  e.arrival = static_cast<double>(c.n) + decimation_ * delta;
   e.score = c.score;
   e.margin = c.margin;
   return e;
 }
 
 std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank) {
-  const std::vector<double>& p = bank.power();
-  if (prev_.empty()) prev_.assign(p.size(), 0.0);
+  const std::vector<double>& q = bank.weighted_power();
+  if (prev_.empty()) prev_.assign(q.size(), 0.0);
   std::optional<Event> out;
   int best;
   double second;
-  best_two(p, best, second);
+  best_two(q, best, second);
   if (cand_ && !cand_->has_next) {
-    cand_->p_next = p[cand_->code];
+    cand_->q_next = q[cand_->code];
     cand_->has_next = true;
   }
+  const std::int64_t n = bank.sample_index();
   const double rho2 = bank.rho2(best);
   const bool gate = rho2 >= cfg_.threshold && bank.energy() >= cfg_.min_energy;
-  if (gate && (!cand_ || p[best] > cand_->p)) {
-    // margin: rho^2(best) - rho^2(second), both normalized by the same energy
-    const double margin = p[best] > 0 ? rho2 * (p[best] - second) / p[best] : 0.0;
-    cand_ = Candidate{n_, best, prev_[best], p[best], 0.0, rho2, margin, false};
-  } else if (cand_ && cand_->has_next && n_ - cand_->n >= holdoff_) {
+  if (gate && (!cand_ || q[best] > cand_->q)) {
+    const double margin = rho2 - (bank.energy() > 0 ? second / bank.energy() : 0.0);
+    cand_ = Candidate{n, best, prev_[best], q[best], 0.0, rho2, margin, false};
+  } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
     out = make_event(*cand_);
     cand_.reset();
   }
-  prev_ = p;
-  ++n_;
+  prev_ = q;
   return out;
 }
 
 std::optional<Event> PeakDetectorFloat::flush() {
   std::optional<Event> out;
   if (cand_) {
-    if (!cand_->has_next) cand_->p_next = cand_->p_prev;  // no right neighbour: symmetric
+    if (!cand_->has_next) cand_->q_next = cand_->q_prev;  // no right neighbour: symmetric
     out = make_event(*cand_);
     cand_.reset();
   }
@@ -114,20 +112,19 @@ PeakDetectorFixed::PeakDetectorFixed(const DetectorConfig& cfg, const Correlator
                                      const CorrelatorFixedConfig& corr)
     : cfg_(cfg),
       score_bits_(corr.score_bits),
-      rho_scale_(layout.rho_scale),
-      holdoff_(cfg.holdoff == -1 ? layout.chips * layout.chip_samples : cfg.holdoff) {
+      decimation_(layout.decimation),
+      holdoff_(cfg.holdoff == -1 ? layout.window : cfg.holdoff) {
   validate(cfg);
   const std::uint64_t cap = (std::uint64_t{1} << score_bits_) - 1;
-  thr_q_ = std::min<std::uint64_t>(cap, static_cast<std::uint64_t>(
-                                            std::llround(std::ldexp(cfg.threshold, score_bits_))));
-  // min_energy is in full-scale units^2: E_raw = E * 2^(2 data_frac); norm = E_raw >> shift.
+  thr_q_ = std::min<std::uint64_t>(
+      cap, static_cast<std::uint64_t>(std::llround(std::ldexp(cfg.threshold, score_bits_))));
+  // min_energy is in full-scale units^2: E_raw = E 2^(2 data_frac); norm = E_raw >> shift.
   const double e_raw = std::ldexp(cfg.min_energy, 2 * corr.data_frac - layout.energy_shift);
   require_in_range("detector.min_energy (in norm units)", e_raw, 0.0, 9.0e18);
   min_norm_ = static_cast<std::uint64_t>(std::ceil(e_raw));
 }
 
 void PeakDetectorFixed::reset() {
-  n_ = 0;
   prev_.clear();
   cand_.reset();
 }
@@ -136,44 +133,42 @@ EventFixed PeakDetectorFixed::make_event(const Candidate& c) const {
   EventFixed e;
   e.code = c.code + 1;
   e.arrival = c.n * (std::int64_t{1} << cfg_.frac_bits) +
-              parabolic_fraction(c.p_prev, c.p, c.p_next, cfg_.frac_bits);
-  e.score = correlation_score(c.p, c.norm, rho_scale_, score_bits_);
-  e.margin = e.score - correlation_score(c.p_second, c.norm, rho_scale_, score_bits_);
+              decimation_ * parabolic_fraction(c.q_prev, c.q, c.q_next, cfg_.frac_bits);
+  e.score = correlation_score(c.q, c.norm, score_bits_);
+  e.margin = e.score - correlation_score(c.q_second, c.norm, score_bits_);
   return e;
 }
 
 std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& bank) {
-  const std::vector<std::int64_t>& p = bank.power();
-  if (prev_.empty()) prev_.assign(p.size(), 0);
+  const std::vector<std::uint64_t>& q = bank.weighted_power();
+  if (prev_.empty()) prev_.assign(q.size(), 0);
   std::optional<EventFixed> out;
   int best;
-  std::int64_t second;
-  best_two(p, best, second);
+  std::uint64_t second;
+  best_two(q, best, second);
   if (cand_ && !cand_->has_next) {
-    cand_->p_next = p[cand_->code];
+    cand_->q_next = q[cand_->code];
     cand_->has_next = true;
   }
+  const std::int64_t n = bank.sample_index();
   const std::uint64_t norm = bank.norm();
-  const unsigned __int128 lhs =
-      static_cast<unsigned __int128>(p[best]) * static_cast<std::uint64_t>(rho_scale_);
-  const unsigned __int128 rhs =
-      static_cast<unsigned __int128>(thr_q_) * std::max<std::uint64_t>(norm, 1);
-  const bool gate = lhs >= rhs && norm >= min_norm_;
-  if (gate && (!cand_ || p[best] > cand_->p)) {
-    cand_ = Candidate{n_, best, prev_[best], p[best], 0, second, norm, false};
-  } else if (cand_ && cand_->has_next && n_ - cand_->n >= holdoff_) {
+  const bool gate = static_cast<uint128_t>(q[best]) >=
+                        static_cast<uint128_t>(thr_q_) * std::max<std::uint64_t>(norm, 1) &&
+                    norm >= min_norm_;
+  if (gate && (!cand_ || q[best] > cand_->q)) {
+    cand_ = Candidate{n, best, prev_[best], q[best], 0, second, norm, false};
+  } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
     out = make_event(*cand_);
     cand_.reset();
   }
-  prev_ = p;
-  ++n_;
+  prev_ = q;
   return out;
 }
 
 std::optional<EventFixed> PeakDetectorFixed::flush() {
   std::optional<EventFixed> out;
   if (cand_) {
-    if (!cand_->has_next) cand_->p_next = cand_->p_prev;  // no right neighbour: symmetric
+    if (!cand_->has_next) cand_->q_next = cand_->q_prev;  // no right neighbour: symmetric
     out = make_event(*cand_);
     cand_.reset();
   }

@@ -1,0 +1,460 @@
+#include "model/receiver.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "model/error.hpp"
+#include "model/excitation.hpp"
+
+namespace ranging {
+
+// ---------------------------------------------------------------------------------------
+// Configuration
+
+int ReceiverConfig::period() const { return static_cast<int>(std::lround(fs / carrier_hz)); }
+int ReceiverConfig::chip_samples() const { return cycles_per_chip * period(); }
+
+void validate(const ReceiverConfig& cfg) {
+  require_in_range("signal.carrier_hz", cfg.carrier_hz, 1e3, 1e8);
+  require_in_range("signal.fs", cfg.fs, 1e3, 1e9);
+  require_in_range("signal.cycles_per_chip", cfg.cycles_per_chip, 1, 64);
+  const double ratio = cfg.fs / cfg.carrier_hz;
+  if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || ratio < 4) {
+    std::ostringstream os;
+    os << "signal.fs / signal.carrier_hz = " << ratio
+       << " must be an integer >= 4 (the LO table holds one carrier cycle)";
+    throw InputError(os.str());
+  }
+  if (cfg.reference != "received" && cfg.reference != "ideal") {
+    throw InputError("correlator.reference: '" + cfg.reference + "' is not valid; valid: received, ideal");
+  }
+  require_in_range("correlator.template_floor", cfg.template_floor, 1e-6, 0.5);
+  require_in_range("correlator.decimation", cfg.decimation, 1, cfg.chip_samples());
+  if (cfg.chip_samples() % cfg.decimation != 0) {
+    throw InputError("correlator.decimation: " + std::to_string(cfg.decimation) +
+                     " must divide the samples per chip (" + std::to_string(cfg.chip_samples()) + ")");
+  }
+  validate(cfg.reference_transducer, cfg.fs);
+  validate(cfg.detector);
+  if (cfg.architecture != "baseband") {
+    throw InputError("architecture: '" + cfg.architecture +
+                     "' is not implemented by the fixed-point model; valid: baseband");
+  }
+  require_in_range("filter.order", cfg.filter_order, 0, 20);
+  validate(cfg.filter);
+  if (cfg.filter.fs != cfg.fs) {
+    throw InputError("filter.fs must equal signal.fs");
+  }
+}
+
+namespace {
+
+[[noreturn]] void fail(const std::string& origin, const YAML::Node& node, const std::string& key,
+                       const std::string& what) {
+  std::ostringstream os;
+  os << origin << ":" << node.Mark().line + 1 << ": " << key << ": " << what;
+  throw InputError(os.str());
+}
+
+// Reads a mapping strictly: every key must be consumed by one of the handlers.
+class MapReader {
+ public:
+  MapReader(const YAML::Node& node, std::string origin, std::string path)
+      : node_(node), origin_(std::move(origin)), path_(std::move(path)) {
+    if (!node_.IsMap()) fail(origin_, node_, path_.empty() ? "(top)" : path_, "expected a mapping");
+  }
+  std::string key(const std::string& k) const { return path_.empty() ? k : path_ + "." + k; }
+
+  template <class T>
+  void get(const std::string& k, T& out) {
+    seen_.insert(k);
+    const YAML::Node v = node_[k];
+    if (!v) return;
+    if (!v.IsScalar()) fail(origin_, v, key(k), "expected a scalar");
+    try {
+      out = v.as<T>();
+    } catch (const YAML::Exception&) {
+      fail(origin_, v, key(k), "'" + v.Scalar() + "' has the wrong type");
+    }
+    if constexpr (std::is_floating_point_v<T>) {
+      if (!std::isfinite(out)) fail(origin_, v, key(k), "value is not finite");
+    }
+  }
+  // An integer, or "auto" (stored as -1).
+  void get_auto(const std::string& k, int& out) {
+    seen_.insert(k);
+    const YAML::Node v = node_[k];
+    if (!v) return;
+    if (v.IsScalar() && v.Scalar() == "auto") {
+      out = -1;
+      return;
+    }
+    get(k, out);
+  }
+  YAML::Node child(const std::string& k) {
+    seen_.insert(k);
+    return node_[k];
+  }
+  void finish() const {
+    for (const auto& kv : node_) {
+      const std::string k = kv.first.as<std::string>();
+      if (!seen_.count(k)) fail(origin_, kv.first, key(k), "unknown key");
+    }
+  }
+  const std::string& origin() const { return origin_; }
+
+ private:
+  YAML::Node node_;
+  std::string origin_, path_;
+  std::set<std::string> seen_;
+};
+
+Rounding parse_rounding(const std::string& s, const std::string& origin, const YAML::Node& n,
+                        const std::string& key) {
+  if (s == "truncate") return Rounding::Truncate;
+  if (s == "round-half-up") return Rounding::RoundHalfUp;
+  if (s == "convergent") return Rounding::Convergent;
+  fail(origin, n, key, "'" + s + "' is not valid; valid: truncate, round-half-up, convergent");
+}
+std::string rounding_name(Rounding r) {
+  switch (r) {
+    case Rounding::Truncate: return "truncate";
+    case Rounding::RoundHalfUp: return "round-half-up";
+    case Rounding::Convergent: return "convergent";
+  }
+  return "?";
+}
+Overflow parse_overflow(const std::string& s, const std::string& origin, const YAML::Node& n,
+                        const std::string& key) {
+  if (s == "wrap") return Overflow::Wrap;
+  if (s == "saturate") return Overflow::Saturate;
+  fail(origin, n, key, "'" + s + "' is not valid; valid: wrap, saturate");
+}
+
+template <class F>
+void section(MapReader& top, const std::string& name, F&& body) {
+  YAML::Node n = top.child(name);
+  if (!n) return;
+  MapReader r(n, top.origin(), name);
+  body(r, n);
+  r.finish();
+}
+
+}  // namespace
+
+ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(origin + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+  }
+  ReceiverConfig cfg;
+  if (!root || root.IsNull()) throw InputError(origin + ": the configuration is empty");
+  MapReader top(root, origin, "");
+  top.get("name", cfg.name);
+  top.get("family", cfg.family);
+  top.get("architecture", cfg.architecture);
+  section(top, "signal", [&](MapReader& r, const YAML::Node&) {
+    r.get("carrier_hz", cfg.carrier_hz);
+    r.get("cycles_per_chip", cfg.cycles_per_chip);
+    r.get("fs", cfg.fs);
+  });
+  std::string type = filter_type_name(cfg.filter_type);
+  section(top, "filter", [&](MapReader& r, const YAML::Node& n) {
+    r.get("type", type);
+    r.get("order", cfg.filter_order);
+    r.get("fp1", cfg.filter.fp1);
+    r.get("fp2", cfg.filter.fp2);
+    r.get("fs1", cfg.filter.fs1);
+    r.get("fs2", cfg.filter.fs2);
+    r.get("rp_db", cfg.filter.rp_db);
+    r.get("rs_db", cfg.filter.rs_db);
+    try {
+      cfg.filter_type = parse_filter_type(type);
+    } catch (const InputError&) {
+      fail(origin, n["type"] ? n["type"] : n, "filter.type",
+           "'" + type + "' is not valid; valid: butter, cheby1, ellip");
+    }
+  });
+  cfg.filter.fs = cfg.fs;
+  section(top, "bandpass_fixed", [&](MapReader& r, const YAML::Node& n) {
+    auto& b = cfg.bandpass;
+    r.get("input_bits", b.input_bits);
+    r.get("coef_bits", b.coef_bits);
+    r.get("coef_frac", b.coef_frac);
+    r.get("data_bits", b.data_bits);
+    r.get("data_frac", b.data_frac);
+    r.get("acc_bits", b.acc_bits);
+    std::string rnd = rounding_name(b.rounding), ovf = b.overflow == Overflow::Wrap ? "wrap" : "saturate";
+    r.get("rounding", rnd);
+    r.get("overflow", ovf);
+    b.rounding = parse_rounding(rnd, origin, n["rounding"] ? n["rounding"] : n, "bandpass_fixed.rounding");
+    b.overflow = parse_overflow(ovf, origin, n["overflow"] ? n["overflow"] : n, "bandpass_fixed.overflow");
+  });
+  section(top, "correlator", [&](MapReader& r, const YAML::Node&) {
+    r.get("reference", cfg.reference);
+    r.get("transducer_centre_hz", cfg.reference_transducer.centre_hz);
+    r.get("transducer_q", cfg.reference_transducer.q);
+    r.get("decimation", cfg.decimation);
+    r.get("template_floor", cfg.template_floor);
+  });
+  section(top, "correlator_fixed", [&](MapReader& r, const YAML::Node&) {
+    auto& c = cfg.correlator;
+    r.get("lo_bits", c.lo_bits);
+    r.get("mix_bits", c.mix_bits);
+    r.get("tap_bits", c.tap_bits);
+    r.get("chip_bits", c.chip_bits);
+    r.get("corr_bits", c.corr_bits);
+    r.get("weight_bits", c.weight_bits);
+    r.get_auto("corr_shift", c.corr_shift);
+    r.get_auto("energy_shift", c.energy_shift);
+    r.get("score_bits", c.score_bits);
+  });
+  section(top, "detector", [&](MapReader& r, const YAML::Node&) {
+    auto& d = cfg.detector;
+    r.get("threshold", d.threshold);
+    r.get_auto("holdoff", d.holdoff);
+    r.get("min_energy", d.min_energy);
+    r.get("frac_bits", d.frac_bits);
+  });
+  top.finish();
+  cfg.correlator.data_bits = cfg.bandpass.data_bits;
+  cfg.correlator.data_frac = cfg.bandpass.data_frac;
+  try {
+    validate(cfg);
+    (void)design_receiver(cfg);  // every derived bound is checked too
+  } catch (const InputError& e) {
+    throw InputError(origin + ": " + e.what());
+  }
+  return cfg;
+}
+
+ReceiverConfig load_receiver_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the configuration file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_receiver_config(ss.str(), path);
+}
+
+std::string receiver_config_yaml(const ReceiverConfig& c) {
+  auto autoint = [](int v) { return v < 0 ? std::string("auto") : std::to_string(v); };
+  std::ostringstream os;
+  os.precision(17);
+  os << "# Receiver configuration (docs/configuration.md): the single source of truth for the\n"
+        "# golden model and the generated HLS C++ and Verilog.\n";
+  os << "name: " << c.name << "\nfamily: " << c.family << "\narchitecture: " << c.architecture << "\n";
+  os << "signal:\n  carrier_hz: " << c.carrier_hz << "\n  cycles_per_chip: " << c.cycles_per_chip
+     << "\n  fs: " << c.fs << "\n";
+  os << "filter:\n  type: " << filter_type_name(c.filter_type) << "\n  order: " << c.filter_order
+     << "\n  fp1: " << c.filter.fp1 << "\n  fp2: " << c.filter.fp2 << "\n  fs1: " << c.filter.fs1
+     << "\n  fs2: " << c.filter.fs2 << "\n  rp_db: " << c.filter.rp_db << "\n  rs_db: " << c.filter.rs_db
+     << "\n";
+  const auto& b = c.bandpass;
+  os << "bandpass_fixed:\n  input_bits: " << b.input_bits << "\n  coef_bits: " << b.coef_bits
+     << "\n  coef_frac: " << b.coef_frac << "\n  data_bits: " << b.data_bits << "\n  data_frac: "
+     << b.data_frac << "\n  acc_bits: " << b.acc_bits << "\n  rounding: " << rounding_name(b.rounding)
+     << "\n  overflow: " << (b.overflow == Overflow::Wrap ? "wrap" : "saturate") << "\n";
+  os << "correlator:\n  reference: " << c.reference << "\n  transducer_centre_hz: "
+     << c.reference_transducer.centre_hz << "\n  transducer_q: " << c.reference_transducer.q
+     << "\n  decimation: " << c.decimation << "\n  template_floor: " << c.template_floor << "\n";
+  const auto& k = c.correlator;
+  os << "correlator_fixed:\n  lo_bits: " << k.lo_bits << "\n  mix_bits: " << k.mix_bits
+     << "\n  tap_bits: " << k.tap_bits << "\n  chip_bits: " << k.chip_bits
+     << "\n  corr_bits: " << k.corr_bits << "\n  weight_bits: " << k.weight_bits
+     << "\n  corr_shift: " << autoint(k.corr_shift)
+     << "\n  energy_shift: " << autoint(k.energy_shift) << "\n  score_bits: " << k.score_bits << "\n";
+  const auto& d = c.detector;
+  os << "detector:\n  threshold: " << d.threshold << "\n  holdoff: " << autoint(d.holdoff)
+     << "\n  min_energy: " << d.min_energy << "\n  frac_bits: " << d.frac_bits << "\n";
+  return os.str();
+}
+
+namespace {
+
+// The waveform the bank is matched to for one chip 1 (chip 0 is its negative): the bare
+// excitation, or its response through the TX and RX transducers and the bandpass filter,
+// trimmed where it has decayed below template_floor of its peak.
+std::vector<double> chip_waveform(const ReceiverConfig& cfg, const SosFilter& filter) {
+  ExcitationParams ex;
+  ex.carrier_hz = cfg.carrier_hz;
+  ex.cycles_per_chip = cfg.cycles_per_chip;
+  ex.fs = cfg.fs;
+  const std::vector<std::uint8_t> one{1};
+  std::vector<double> w = bpsk_excitation(one, ex);
+  if (cfg.reference == "ideal") return w;
+  w.resize(static_cast<std::size_t>(cfg.chip_samples()) * 20, 0.0);
+  Transducer tx(cfg.reference_transducer, cfg.fs), rx(cfg.reference_transducer, cfg.fs);
+  BandpassFloat bp(filter);
+  double peak = 0;
+  for (double& v : w) {
+    v = bp.execute(rx.execute(tx.execute(v)));
+    peak = std::max(peak, std::abs(v));
+  }
+  std::size_t last = 0;
+  for (std::size_t n = 0; n < w.size(); ++n) {
+    if (std::abs(w[n]) >= cfg.template_floor * peak) last = n;
+  }
+  w.resize(last + 1);
+  return w;
+}
+
+}  // namespace
+
+ReceiverDesign design_receiver(const ReceiverConfig& cfg_in) {
+  ReceiverConfig cfg = cfg_in;
+  cfg.filter.fs = cfg.fs;
+  cfg.correlator.data_bits = cfg.bandpass.data_bits;
+  cfg.correlator.data_frac = cfg.bandpass.data_frac;
+  validate(cfg);
+  ReceiverDesign d;
+  d.config = cfg;
+  d.family = code_family(cfg.family);
+  d.filter = cfg.filter_order > 0 ? design_bandpass(cfg.filter, cfg.filter_type, cfg.filter_order)
+                                  : design_bandpass(cfg.filter, cfg.filter_type);
+  // Constructing the fixed filter validates its word lengths against the coefficients.
+  BandpassFixed check(d.filter, cfg.bandpass);
+
+  CorrelatorReference& ref = d.reference;
+  ref.period = cfg.period();
+  ref.chip_samples = cfg.chip_samples();
+  ref.decimation = cfg.decimation;
+  ref.codes = d.family.codes;
+  const std::vector<double> chip = chip_waveform(cfg, d.filter);
+
+  // Chip template in the bank's own domain: mixed to baseband, boxcar-decimated by D, rotated
+  // to its dominant phase and made real (2 multiplies per tap instead of 4), time reversed.
+  const int D = cfg.decimation;
+  // Pad so the template's tail passes the whole one-cycle moving sum.
+  std::vector<double> padded(chip);
+  padded.resize(chip.size() + static_cast<std::size_t>(ref.period + D), 0.0);
+  const std::vector<std::complex<double>> h = baseband_decimate(padded, ref.period, D);
+  ref.chip_peak = ref.corr_peak = 0;
+  std::complex<double> dominant = 0;
+  double hmax = 0;
+  for (const auto& v : h) {
+    dominant += v * std::abs(v);
+    hmax = std::max(hmax, std::abs(v));
+  }
+  std::size_t m = 0;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    if (std::abs(h[k]) >= cfg.template_floor * hmax) m = k + 1;
+  }
+  const std::complex<double> rot = std::polar(1.0, -std::arg(dominant));
+  for (std::size_t i = 0; i < m; ++i) ref.chip_taps.push_back((h[m - 1 - i] * rot).real() / hmax);
+  ref.window = (d.family.length - 1) * ref.chip_samples + static_cast<int>(m) * D;
+
+  // Every code's full-rate template and its normalization K_j = P_j / E at its own peak.
+  ref.code_gain.assign(d.family.codes.size(), 1.0);
+  CorrelatorBankFloat probe(ref);
+  for (std::size_t j = 0; j < d.family.codes.size(); ++j) {
+    std::vector<double> t(static_cast<std::size_t>(ref.window + 2 * ref.chip_samples), 0.0);
+    for (std::size_t c = 0; c < d.family.codes[j].size(); ++c) {
+      const double s = d.family.codes[j][c] ? 1.0 : -1.0;
+      for (std::size_t n = 0; n < chip.size(); ++n) t[c * ref.chip_samples + n] += s * chip[n];
+    }
+    probe.reset();
+    double best_p = -1, gain = 1, tpeak = 0;
+    for (double v : t) tpeak = std::max(tpeak, std::abs(v));
+    for (double v : t) {
+      if (!probe.execute(v)) continue;
+      ref.chip_peak = std::max(ref.chip_peak, probe.chip_magnitude() / tpeak);
+      ref.corr_peak = std::max(ref.corr_peak, probe.max_corr_magnitude() / tpeak);
+      if (probe.weighted_power()[j] > best_p && probe.energy() > 0) {
+        best_p = probe.weighted_power()[j];
+        gain = best_p / probe.energy();
+      }
+    }
+    ref.code_gain[j] = gain;
+    d.templates.push_back(std::move(t));
+  }
+  d.layout = resolve_correlator_layout(ref, cfg.correlator);
+  return d;
+}
+
+// ---------------------------------------------------------------------------------------
+// Receivers
+
+std::int64_t quantize_input(double x, int bits, OverflowCounter* counter) {
+  const FixedFormat fmt{bits, bits - 1, true, Rounding::RoundHalfUp, Overflow::Saturate};
+  if (!std::isfinite(x)) throw InputError("receiver input: sample is not finite");
+  // x * 2^(bits-1) with 20 guard bits below the LSB, so the rounding sees the true fraction.
+  const double scaled = std::ldexp(x, bits - 1 + 20);
+  const double lim = std::ldexp(1.0, 100);
+  const int128_t raw = static_cast<int128_t>(std::clamp(std::floor(scaled), -lim, lim));
+  return fx_quantize(raw, bits - 1 + 20, fmt, counter);
+}
+
+ReceiverFloat::ReceiverFloat(const ReceiverDesign& d)
+    : filter_(d.filter),
+      bank_(d.reference),
+      detector_(d.config.detector, d.reference) {}
+
+void ReceiverFloat::reset() {
+  filter_.reset();
+  bank_.reset();
+  detector_.reset();
+  filtered_ = 0;
+}
+
+std::optional<Event> ReceiverFloat::execute(double x) {
+  filtered_ = filter_.execute(x);
+  if (!bank_.execute(filtered_)) return std::nullopt;
+  return detector_.execute(bank_);
+}
+
+ReceiverFixed::ReceiverFixed(const ReceiverDesign& d)
+    : input_bits_(d.config.bandpass.input_bits),
+      frac_bits_(d.config.detector.frac_bits),
+      score_bits_(d.config.correlator.score_bits),
+      filter_(d.filter, d.config.bandpass),
+      bank_(d.reference, d.config.correlator),
+      detector_(d.config.detector, bank_.layout(), d.config.correlator) {}
+
+void ReceiverFixed::reset() {
+  filter_.reset();
+  bank_.reset();
+  detector_.reset();
+  filtered_ = 0;
+  input_counter_ = {};
+}
+
+std::optional<EventFixed> ReceiverFixed::execute_raw(std::int64_t x) {
+  filtered_ = filter_.execute_raw(x);
+  if (!bank_.execute(filtered_)) return std::nullopt;
+  return detector_.execute(bank_);
+}
+
+Event ReceiverFixed::to_float(const EventFixed& e) const { return e.to_float(frac_bits_, score_bits_); }
+
+std::optional<Event> ReceiverFixed::execute(double x) {
+  auto e = execute_raw(quantize_input(x, input_bits_, &input_counter_));
+  if (!e) return std::nullopt;
+  return to_float(*e);
+}
+
+std::optional<Event> ReceiverFixed::flush() {
+  auto e = flush_raw();
+  if (!e) return std::nullopt;
+  return to_float(*e);
+}
+
+OverflowCounter ReceiverFixed::overflow_events() const {
+  OverflowCounter c = input_counter_;
+  const OverflowCounter f = filter_.overflow_events();
+  const OverflowCounter b = bank_.overflow_events();
+  c.saturations += f.saturations + b.saturations;
+  c.wraps += f.wraps + b.wraps;
+  return c;
+}
+
+}  // namespace ranging
