@@ -11,5 +11,6 @@ using Args = std::vector<std::string>;
 int cmd_codes(const Args& args);   // code families (cmd_codes.cpp)
 int cmd_filter(const Args& args);  // bandpass filter design (cmd_filter.cpp)
 int cmd_demo(const Args& args);    // encode, channel, filter, decode every code (cmd_demo.cpp)
+int cmd_generate(const Args& args);  // HLS C++ and Verilog from a configuration (cmd_generate.cpp)
 
 }  // namespace ranging::tool

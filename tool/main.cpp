@@ -23,6 +23,8 @@ constexpr Subcommand kSubcommands[] = {
      ranging::tool::cmd_codes},
     {"filter", "design the bandpass filter; print sections and quantized coefficients",
      ranging::tool::cmd_filter},
+    {"generate", "generate the HLS C++ and Verilog of a receiver configuration",
+     ranging::tool::cmd_generate},
 };
 
 void print_usage(std::ostream& os) {

@@ -1,0 +1,32 @@
+// `ranging generate`: the hardware files of one receiver configuration (docs/hardware.md).
+#include <iostream>
+
+#include "model/error.hpp"
+#include "model/hw_generator.hpp"
+#include "tool/cli.hpp"
+#include "tool/commands.hpp"
+
+namespace ranging::tool {
+
+int cmd_generate(const Args& args) {
+  cli::Parser p("ranging generate",
+                "Generate the HLS C++ configuration and the Verilog of the receiver described by a\n"
+                "configuration file. The output folder is replaced atomically: on error nothing is\n"
+                "written.");
+  p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md)");
+  p.option("--out", "DIR", "output folder");
+  p.option("--origin", "NAME", "name of the configuration in the generated banners (default: FILE as given)");
+  if (!p.parse(args)) return 0;
+  const auto config = p.get("--config");
+  const auto out = p.get("--out");
+  if (!config) throw InputError("option --config is required");
+  if (!out) throw InputError("option --out is required");
+  const ReceiverDesign design = design_receiver(load_receiver_config(*config));
+  const auto files = generate_hardware_files(design, p.get_or("--origin", *config));
+  write_hardware_files(files, *out);
+  std::cout << "generated " << files.size() << " files for configuration '" << design.config.name
+            << "' in " << *out << "\n";
+  return 0;
+}
+
+}  // namespace ranging::tool
