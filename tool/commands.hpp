@@ -12,5 +12,8 @@ int cmd_codes(const Args& args);   // code families (cmd_codes.cpp)
 int cmd_filter(const Args& args);  // bandpass filter design (cmd_filter.cpp)
 int cmd_demo(const Args& args);    // encode, channel, filter, decode every code (cmd_demo.cpp)
 int cmd_generate(const Args& args);  // HLS C++ and Verilog from a configuration (cmd_generate.cpp)
+int cmd_simulate(const Args& args);  // run a scene (cmd_simulate.cpp)
+int cmd_evaluate(const Args& args);  // reproduce the paper's Section 4 (cmd_evaluate.cpp)
+int cmd_decode(const Args& args);    // decode a real capture (cmd_decode.cpp)
 
 }  // namespace ranging::tool

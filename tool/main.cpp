@@ -25,6 +25,11 @@ constexpr Subcommand kSubcommands[] = {
      ranging::tool::cmd_filter},
     {"generate", "generate the HLS C++ and Verilog of a receiver configuration",
      ranging::tool::cmd_generate},
+    {"simulate", "run a scene: channel, receiver, per-measurement CSV and summary JSON",
+     ranging::tool::cmd_simulate},
+    {"evaluate", "reproduce the paper's Section 4 evaluation (Tables 4-6, Figures 13-15)",
+     ranging::tool::cmd_evaluate},
+    {"decode", "decode a recorded capture (oscilloscope CSV or WAV)", ranging::tool::cmd_decode},
 };
 
 void print_usage(std::ostream& os) {
