@@ -71,6 +71,134 @@ std::string manifest(const ReceiverDesign& d, const std::vector<HwModuleParams>&
   return j.dump(2) + "\n";
 }
 
+std::string instance_params(const HwModuleParams& m) {
+  std::ostringstream os;
+  for (std::size_t i = 0; i < m.params.size(); ++i) {
+    os << "    ." << m.params[i].name << "(" << m.params[i].verilog << ")"
+       << (i + 1 < m.params.size() ? ",\n" : "\n");
+  }
+  return os.str();
+}
+
+const HwModuleParams& find(const std::vector<HwModuleParams>& mods, const std::string& name) {
+  for (const auto& m : mods) {
+    if (m.module == name) return m;
+  }
+  throw std::logic_error("no module " + name);
+}
+
+// The top: stages chained by valid/ready, the event stream out, a debug tap per stage.
+std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::string& origin) {
+  const auto& sos = find(mods, "bandpass_sos");
+  const auto& bank = find(mods, "correlator_bank");
+  const auto& det = find(mods, "peak_detector");
+  const auto in_w = sos.value("IN_W"), data_w = sos.value("DATA_W"), sections = sos.value("SECTIONS");
+  const auto codes = bank.value("CODES"), weighted_w = bank.value("WEIGHTED_W");
+  const auto energy_w = bank.value("ENERGY_W"), time_w = bank.value("TIME_W");
+  const auto chip_w = bank.value("CHIP_W"), corr_w = bank.value("CORR_W");
+  const auto code_w = det.value("CODE_W"), frac_w = det.value("FRAC_W"), score_w = det.value("SCORE_W");
+  const auto arrival_w = time_w + frac_w + 1;
+  const auto event_w = code_w + arrival_w + 2 * score_w;
+  std::ostringstream os;
+  os << banner("//", origin)
+     << "//\n"
+        "// receiver_top: the coded-ultrasound receiver (docs/architecture.md):\n"
+        "//   s_axis (signed ADC samples) -> bandpass_sos -> correlator_bank -> peak_detector -> m_axis (events)\n"
+        "// Event word, LSB first: code (" << code_w << " bits, 1-based), arrival (" << arrival_w
+     << " bits, signed sample index with " << frac_w << " fraction bits), score (" << score_w
+     << " bits, rho^2), margin (" << score_w << " bits).\n"
+        "// Back-pressure on m_axis stalls the pipeline back to s_axis_tready: no event is lost.\n"
+        "// The dbg_* ports are the stage taps the testbenches compare with the golden model;\n"
+        "// each is valid on the cycle its *_valid strobe is high (a completed beat).\n"
+        "`default_nettype none\n\n"
+        "module receiver_top (\n"
+        "  input  wire clk,\n"
+        "  input  wire rst,\n"
+        "  input  wire signed [" << in_w - 1 << ":0] s_axis_tdata,\n"
+        "  input  wire s_axis_tvalid,\n"
+        "  output wire s_axis_tready,\n"
+        "  output wire [" << event_w - 1 << ":0] m_axis_tdata,\n"
+        "  output wire m_axis_tvalid,\n"
+        "  input  wire m_axis_tready,\n"
+        "  output wire dbg_filter_valid,\n"
+        "  output wire signed [" << data_w - 1 << ":0] dbg_filter_data,\n"
+        "  output wire [" << sections * data_w - 1 << ":0] dbg_filter_sections,\n"
+        "  output wire dbg_bank_valid,\n"
+        "  output wire [" << codes * weighted_w - 1 << ":0] dbg_weighted,\n"
+        "  output wire [" << energy_w - 1 << ":0] dbg_energy,\n"
+        "  output wire [" << time_w - 1 << ":0] dbg_index,\n"
+        "  output wire signed [" << chip_w - 1 << ":0] dbg_chip_re,\n"
+        "  output wire signed [" << chip_w - 1 << ":0] dbg_chip_im,\n"
+        "  output wire [" << codes * corr_w - 1 << ":0] dbg_corr_re,\n"
+        "  output wire [" << codes * corr_w - 1 << ":0] dbg_corr_im\n"
+        ");\n\n"
+        "  wire signed [" << data_w - 1 << ":0] filter_data;\n"
+        "  wire filter_valid, filter_ready;\n"
+        "  wire bank_valid, bank_ready;\n"
+        "  wire [" << codes * weighted_w - 1 << ":0] bank_weighted;\n"
+        "  wire [" << energy_w - 1 << ":0] bank_energy;\n"
+        "  wire [" << time_w - 1 << ":0] bank_index;\n"
+        "  wire [" << code_w - 1 << ":0] event_code;\n"
+        "  wire signed [" << arrival_w - 1 << ":0] event_arrival;\n"
+        "  wire [" << score_w - 1 << ":0] event_score, event_margin;\n\n"
+        "  bandpass_sos #(\n" << instance_params(sos) << "  ) u_filter (\n"
+        "    .clk(clk), .rst(rst),\n"
+        "    .s_data(s_axis_tdata), .s_valid(s_axis_tvalid), .s_ready(s_axis_tready),\n"
+        "    .m_data(filter_data), .m_valid(filter_valid), .m_ready(filter_ready),\n"
+        "    .m_sections(dbg_filter_sections)\n"
+        "  );\n\n"
+        "  correlator_bank #(\n" << instance_params(bank) << "  ) u_bank (\n"
+        "    .clk(clk), .rst(rst),\n"
+        "    .s_data(filter_data), .s_valid(filter_valid), .s_ready(filter_ready),\n"
+        "    .m_valid(bank_valid), .m_ready(bank_ready),\n"
+        "    .m_weighted(bank_weighted), .m_energy(bank_energy), .m_index(bank_index),\n"
+        "    .m_chip_re(dbg_chip_re), .m_chip_im(dbg_chip_im),\n"
+        "    .m_corr_re(dbg_corr_re), .m_corr_im(dbg_corr_im)\n"
+        "  );\n\n"
+        "  peak_detector #(\n" << instance_params(det) << "  ) u_detector (\n"
+        "    .clk(clk), .rst(rst),\n"
+        "    .s_valid(bank_valid), .s_ready(bank_ready),\n"
+        "    .s_weighted(bank_weighted), .s_energy(bank_energy), .s_index(bank_index),\n"
+        "    .m_valid(m_axis_tvalid), .m_ready(m_axis_tready),\n"
+        "    .m_code(event_code), .m_arrival(event_arrival),\n"
+        "    .m_score(event_score), .m_margin(event_margin)\n"
+        "  );\n\n"
+        "  assign m_axis_tdata = {event_margin, event_score, event_arrival, event_code};\n"
+        "  assign dbg_filter_valid = filter_valid & filter_ready;\n"
+        "  assign dbg_filter_data = filter_data;\n"
+        "  assign dbg_bank_valid = bank_valid & bank_ready;\n"
+        "  assign dbg_weighted = bank_weighted;\n"
+        "  assign dbg_energy = bank_energy;\n"
+        "  assign dbg_index = bank_index;\n\n"
+        "endmodule\n\n`default_nettype wire\n";
+  return os.str();
+}
+
+// GTKWave save file: the stages of receiver_top in order, as the testbench names them.
+std::string gtkw(const std::vector<HwModuleParams>& mods, const std::string& origin) {
+  const auto& sos = find(mods, "bandpass_sos");
+  const auto& bank = find(mods, "correlator_bank");
+  const auto& det = find(mods, "peak_detector");
+  auto bus = [](const std::string& name, std::int64_t w) {
+    return "TOP.receiver_top." + name + "[" + std::to_string(w - 1) + ":0]\n";
+  };
+  std::ostringstream os;
+  os << banner("#", origin) << "[*] open with: gtkwave <trace>.fst receiver.gtkw\n"
+     << "[timestart] 0\n"
+     << "@200\n-input samples\n@28\nTOP.receiver_top.s_axis_tvalid\nTOP.receiver_top.s_axis_tready\n"
+     << "@8420\n" << bus("s_axis_tdata", sos.value("IN_W"))
+     << "@200\n-bandpass filter\n@28\nTOP.receiver_top.dbg_filter_valid\n"
+     << "@8420\n" << bus("dbg_filter_data", sos.value("DATA_W"))
+     << "@200\n-correlator bank\n@28\nTOP.receiver_top.dbg_bank_valid\n"
+     << "@8420\n" << bus("dbg_chip_re", bank.value("CHIP_W")) << bus("dbg_chip_im", bank.value("CHIP_W"))
+     << "@22\n" << bus("dbg_energy", bank.value("ENERGY_W")) << bus("dbg_index", bank.value("TIME_W"))
+     << "@200\n-events\n@28\nTOP.receiver_top.m_axis_tvalid\nTOP.receiver_top.m_axis_tready\n"
+     << "@22\n" << bus("event_code", det.value("CODE_W"))
+     << bus("event_arrival", bank.value("TIME_W") + det.value("FRAC_W") + 1)
+     << bus("event_score", det.value("SCORE_W")) << bus("event_margin", det.value("SCORE_W"));
+  return os.str();
+}
+
 }  // namespace
 
 std::map<std::string, std::string> generate_hardware_files(const ReceiverDesign& design,
@@ -78,6 +206,8 @@ std::map<std::string, std::string> generate_hardware_files(const ReceiverDesign&
   const auto mods = hardware_parameters(design);
   std::map<std::string, std::string> files;
   for (const auto& m : mods) files["rtl/" + m.module + ".vc"] = vc_file(m);
+  files["rtl/receiver_top.v"] = verilog_top(mods, origin);
+  files["receiver.gtkw"] = gtkw(mods, origin);
   files["hls/receiver_config.hpp"] = hls_config(mods, origin);
   files["manifest.json"] = manifest(design, mods, origin);
   return files;
