@@ -61,19 +61,32 @@ std::string verilog_packed(const std::vector<std::int64_t>& elements, int bits) 
   return std::to_string(total) + "'h" + hex;
 }
 
+namespace {
+
+void check_family_size(const std::string& name, int chips, int codes) {
+  if (chips > 63) {
+    throw InputError("family: " + name + " has codes of " + std::to_string(chips) +
+                     " chips, which the hardware does not support; valid range is [1, 63]");
+  }
+  if (codes > 63) {
+    throw InputError("family: " + name + " has " + std::to_string(codes) +
+                     " codes, which the hardware does not support; valid range is [1, 63]");
+  }
+}
+
+}  // namespace
+
+void check_generatable(const ReceiverConfig& config) {
+  const CodeFamily f = code_family(config.family);
+  check_family_size(f.name, f.length, f.eta());
+}
+
 void check_generatable(const ReceiverDesign& d) {
   const auto& l = d.layout;
   const auto& b = d.config.bandpass;
   if (b.acc_bits > 64) throw InputError("bandpass_fixed.acc_bits: hardware supports at most 64");
   if (l.fir_bits > 63) throw InputError("correlator_fixed: chip filter accumulator above 63 bits");
-  if (l.chips > 63) {
-    throw InputError("family: codes of " + std::to_string(l.chips) +
-                     " chips are not supported by the hardware; valid range is [1, 63]");
-  }
-  if (l.codes > 63) {
-    throw InputError("family: " + std::to_string(l.codes) +
-                     " codes are not supported by the hardware; valid range is [1, 63]");
-  }
+  check_family_size(d.family.name, l.chips, l.codes);
 }
 
 std::vector<HwModuleParams> hardware_parameters(const ReceiverDesign& d) {

@@ -34,5 +34,7 @@ std::vector<HwModuleParams> hardware_parameters(const ReceiverDesign& design);
 // Throws InputError naming the configuration key when the design cannot be generated
 // (a width the hardware modules cannot hold, a code too long, ...).
 void check_generatable(const ReceiverDesign& design);
+// The cheap part of the same check, before the design is computed (family size).
+void check_generatable(const ReceiverConfig& config);
 
 }  // namespace ranging

@@ -353,24 +353,28 @@ ReceiverDesign design_receiver(const ReceiverConfig& cfg_in) {
   for (std::size_t i = 0; i < m; ++i) ref.chip_taps.push_back((h[m - 1 - i] * rot).real() / hmax);
   ref.window = (d.family.length - 1) * ref.chip_samples + static_cast<int>(m) * D;
 
-  // Every code's full-rate template and its normalization K_j = P_j / E at its own peak.
+  // Every code's full-rate template and its normalization K_j = P_j / E at its own peak,
+  // measured by a one-code float bank (cost linear in the family size). chip_peak and
+  // corr_peak (the fixed-point scaling) are the largest |F| and own |C_j| per unit input peak.
   ref.code_gain.assign(d.family.codes.size(), 1.0);
-  CorrelatorBankFloat probe(ref);
   for (std::size_t j = 0; j < d.family.codes.size(); ++j) {
     std::vector<double> t(static_cast<std::size_t>(ref.window + 2 * ref.chip_samples), 0.0);
     for (std::size_t c = 0; c < d.family.codes[j].size(); ++c) {
       const double s = d.family.codes[j][c] ? 1.0 : -1.0;
       for (std::size_t n = 0; n < chip.size(); ++n) t[c * ref.chip_samples + n] += s * chip[n];
     }
-    probe.reset();
+    CorrelatorReference one = ref;
+    one.codes = {d.family.codes[j]};
+    one.code_gain = {1.0};
+    CorrelatorBankFloat probe(one);
     double best_p = -1, gain = 1, tpeak = 0;
     for (double v : t) tpeak = std::max(tpeak, std::abs(v));
     for (double v : t) {
       if (!probe.execute(v)) continue;
       ref.chip_peak = std::max(ref.chip_peak, probe.chip_magnitude() / tpeak);
       ref.corr_peak = std::max(ref.corr_peak, probe.max_corr_magnitude() / tpeak);
-      if (probe.weighted_power()[j] > best_p && probe.energy() > 0) {
-        best_p = probe.weighted_power()[j];
+      if (probe.weighted_power()[0] > best_p && probe.energy() > 0) {
+        best_p = probe.weighted_power()[0];
         gain = best_p / probe.energy();
       }
     }

@@ -3,6 +3,7 @@
 
 #include "model/error.hpp"
 #include "model/hw_generator.hpp"
+#include "model/hw_params.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 
@@ -21,7 +22,9 @@ int cmd_generate(const Args& args) {
   const auto out = p.get("--out");
   if (!config) throw InputError("option --config is required");
   if (!out) throw InputError("option --out is required");
-  const ReceiverDesign design = design_receiver(load_receiver_config(*config));
+  const ReceiverConfig cfg = load_receiver_config(*config);
+  check_generatable(cfg);  // cheap checks first: the design of a large family takes time
+  const ReceiverDesign design = design_receiver(cfg);
   const auto files = generate_hardware_files(design, p.get_or("--origin", *config));
   write_hardware_files(files, *out);
   std::cout << "generated " << files.size() << " files for configuration '" << design.config.name

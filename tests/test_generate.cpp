@@ -1,0 +1,135 @@
+// `ranging generate`: parameters come only from the model; bad configurations are refused
+// with the key named and nothing written.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "model/error.hpp"
+#include "model/hw_generator.hpp"
+#include "model/hw_params.hpp"
+
+using namespace ranging;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ToolRun {
+  int status;
+  std::string out, err;
+};
+
+ToolRun run_tool(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / ("gen_err_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(RANGING_TOOL) + " " + args + " 2>" + err.string();
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, pipe.get())) > 0) out.append(buf, n);
+  const int status = pclose(pipe.release());
+  std::ifstream e(err);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  fs::remove(err);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, ss.str()};
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("ranging_gen_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(p);
+  return p;
+}
+
+fs::path write_config(const std::string& name, const std::string& text) {
+  const fs::path p = fs::temp_directory_path() / ("ranging_cfg_" + name + "_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(p) << text;
+  return p;
+}
+
+}  // namespace
+
+TEST(Generate, VerilogPackedPlacesElementIAtBitsIW) {
+  EXPECT_EQ(verilog_packed({1, 2, 3}, 4), "12'h321");
+  EXPECT_EQ(verilog_packed({-1, 0}, 4), "8'h0f");
+  EXPECT_EQ(verilog_packed({-2}, 3), "3'h6");
+  EXPECT_EQ(verilog_packed({1, 0, 1, 1}, 1), "4'hd");
+}
+
+TEST(Generate, ParametersComeFromTheModel) {
+  const ReceiverDesign d = design_receiver(load_receiver_config(std::string(RANGING_SOURCE_DIR) + "/configs/default.yaml"));
+  const auto mods = hardware_parameters(d);
+  ASSERT_EQ(mods.size(), 3u);
+  const BandpassFixed bp(d.filter, d.config.bandpass);
+  const auto& sos = mods[0];
+  EXPECT_EQ(sos.module, "bandpass_sos");
+  EXPECT_EQ(sos.value("SECTIONS"), static_cast<std::int64_t>(bp.coefficients().size()));
+  EXPECT_EQ(sos.at("COEFS").elements[3], bp.coefficients()[0][3]);  // section 1 a1
+  const auto& bank = mods[1];
+  EXPECT_EQ(bank.value("TAPS"), d.layout.taps);
+  EXPECT_EQ(bank.at("WEIGHTS").elements, d.layout.weights);
+  EXPECT_EQ(bank.at("TAP_VALUES").elements, d.layout.taps_q);
+  EXPECT_EQ(bank.value("CHIP_SHIFT"), d.layout.chip_shift);
+  const auto& det = mods[2];
+  const PeakDetectorFixed pd(d.config.detector, d.layout, d.config.correlator);
+  EXPECT_EQ(det.value("HOLDOFF"), pd.holdoff());
+  EXPECT_EQ(det.at("THRESHOLD").elements[0], static_cast<std::int64_t>(pd.threshold_q()));
+}
+
+TEST(Generate, WritesEveryFileAndTheTopInstantiatesEveryModule) {
+  const fs::path out = temp_dir("ok");
+  const ToolRun r = run_tool("generate --config " + std::string(RANGING_SOURCE_DIR) +
+                             "/configs/default.yaml --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* f : {"rtl/receiver_top.v", "rtl/bandpass_sos.vc", "rtl/correlator_bank.vc",
+                        "rtl/peak_detector.vc", "hls/receiver_config.hpp", "receiver.gtkw", "manifest.json"}) {
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  }
+  std::ifstream top(out / "rtl/receiver_top.v");
+  std::stringstream ss;
+  ss << top.rdbuf();
+  for (const char* inst : {"bandpass_sos #(", "correlator_bank #(", "peak_detector #(", "Do not edit by hand"}) {
+    EXPECT_NE(ss.str().find(inst), std::string::npos) << inst;
+  }
+  fs::remove_all(out);
+}
+
+TEST(Generate, ImpossibleConfigurationsAreRefusedAndNothingIsWritten) {
+  struct Case {
+    const char* yaml;
+    const char* key;
+  } cases[] = {
+      {"bandpass_fixed:\n  acc_bits: 24\n", "acc_bits"},
+      {"bandpass_fixed:\n  coef_bits: 8\n  coef_frac: 7\n", "section"},  // a1 ~ -1.9 does not fit Q1.7
+      {"family: mseq-7\n", "family"},                                     // 127 chips: beyond the hardware
+      {"correlator_fixed:\n  mix_bits: 40\n", "mix_bits"},
+      {"correlator:\n  decimation: 7\n", "decimation"},
+  };
+  for (const auto& c : cases) {
+    const fs::path cfg = write_config("bad", c.yaml);
+    const fs::path out = temp_dir("bad");
+    const ToolRun r = run_tool("generate --config " + cfg.string() + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << c.yaml;
+    EXPECT_NE(r.err.find(c.key), std::string::npos) << c.yaml << " -> " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << "nothing may be written for " << c.yaml;
+    for (const auto& e : fs::directory_iterator(out.parent_path())) {
+      EXPECT_EQ(e.path().filename().string().rfind(".tmp-" + out.filename().string(), 0), std::string::npos)
+          << "temporary folder left behind: " << e.path();
+    }
+    fs::remove(cfg);
+  }
+}
+
+TEST(Generate, AFailedRunLeavesAPreviousOutputUntouched) {
+  const fs::path out = temp_dir("keep");
+  fs::create_directories(out);
+  std::ofstream(out / "marker") << "old";
+  const fs::path cfg = write_config("bad2", "bandpass_fixed:\n  acc_bits: 24\n");
+  const ToolRun r = run_tool("generate --config " + cfg.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(fs::exists(out / "marker"));
+  fs::remove_all(out);
+  fs::remove(cfg);
+}
