@@ -1,0 +1,472 @@
+// rtl/correlator_bank.v against CorrelatorBankFixed, bit for bit, on every decimated output:
+// Q_j of every code, E, the sample index, F_q (chip filter) and C_q of every code.
+// Inputs: the default design's filtered received bursts of every Gold4 code at 100, 550 and
+// 1000 mm with and without noise, full-scale worst-case inputs and random noise, with random
+// s_valid gaps, random m_ready back-pressure and resets in the middle of a stream. Also the
+// Verilator lint (-Wall) and an Icarus run of the same module on vectors from the model.
+// RANGING_TRACE=1 writes $RANGING_TRACE_DIR/tb_correlator_bank.fst.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "model/bandpass_filter.hpp"
+#include "model/channel.hpp"
+#include "model/excitation.hpp"
+#include "model/receiver.hpp"
+// Verilator's runtime headers are not warning-clean under -Wextra -Werror.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#include "Vcorrelator_bank.h"
+#include "verilated.h"
+#include "verilated_fst_c.h"
+#pragma GCC diagnostic pop
+
+namespace {
+
+using namespace ranging;
+
+const ReceiverDesign& design() {
+  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
+  return d;
+}
+
+template <std::size_t N>
+std::uint64_t bits_of(const VlWide<N>& w, int lo, int width) {
+  std::uint64_t r = 0;
+  for (int b = 0; b < width; ++b) {
+    const int i = lo + b;
+    r |= static_cast<std::uint64_t>((w[static_cast<std::size_t>(i / 32)] >> (i % 32)) & 1u) << b;
+  }
+  return r;
+}
+std::int64_t sext(std::uint64_t v, int width) {
+  const std::uint64_t m = std::uint64_t{1} << (width - 1);
+  return static_cast<std::int64_t>((v ^ m) - m);
+}
+
+struct Output {
+  std::vector<std::uint64_t> q;
+  std::uint64_t energy = 0, index = 0;
+  std::int64_t chip_re = 0, chip_im = 0;
+  std::vector<std::int64_t> corr_re, corr_im;
+};
+
+// The model's decimated outputs for a stream from reset.
+std::vector<Output> model_outputs(const std::vector<std::int64_t>& y) {
+  const auto& d = design();
+  CorrelatorBankFixed bank(d.reference, d.config.correlator);
+  std::vector<Output> out;
+  for (std::int64_t v : y) {
+    if (!bank.execute(v)) continue;
+    Output o;
+    o.q = bank.weighted_power();
+    o.energy = bank.energy();
+    o.index = static_cast<std::uint64_t>(bank.sample_index());
+    o.chip_re = bank.chip_re();
+    o.chip_im = bank.chip_im();
+    o.corr_re = bank.corr_re();
+    o.corr_im = bank.corr_im();
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+// Filtered received burst of code j at distance_mm (bandpass model over the ADC codes).
+std::vector<std::int64_t> filtered_burst(std::size_t code, double distance_mm, double noise,
+                                         std::uint64_t seed, std::size_t* arrival) {
+  const auto& d = design();
+  ExcitationParams ex;
+  ex.carrier_hz = d.config.carrier_hz;
+  ex.cycles_per_chip = d.config.cycles_per_chip;
+  ex.fs = d.config.fs;
+  const auto exc = bpsk_excitation(d.family.codes.at(code), ex);
+  ChannelParams ch;
+  ch.distance_m = distance_mm / 1000.0;
+  ch.gain = 0.5;
+  ch.noise_rms = noise;
+  ch.seed = seed;
+  const double delay = ch.distance_m / ch.speed_of_sound * d.config.fs;
+  *arrival = static_cast<std::size_t>(delay);
+  const auto rx = propagate(exc, ch, d.config.fs, *arrival + 2600);
+  BandpassFixed bp(d.filter, d.config.bandpass);
+  OverflowCounter oc;
+  std::vector<std::int64_t> y;
+  y.reserve(rx.size());
+  for (double v : rx) y.push_back(bp.execute_raw(quantize_input(v, d.config.bandpass.input_bits, &oc)));
+  return y;
+}
+
+class BankSim {
+ public:
+  BankSim() : ctx_(std::make_unique<VerilatedContext>()), top_(std::make_unique<Vcorrelator_bank>(ctx_.get())) {
+    const char* tr = std::getenv("RANGING_TRACE");
+    if (tr && std::string(tr) == "1") {
+      ctx_->traceEverOn(true);
+      trace_ = std::make_unique<VerilatedFstC>();
+      top_->trace(trace_.get(), 99);
+      const char* dir = std::getenv("RANGING_TRACE_DIR");
+      trace_->open((std::string(dir ? dir : RANGING_TRACE_DIR) + "/tb_correlator_bank.fst").c_str());
+    }
+    top_->clk = 0;
+    top_->rst = 1;
+    top_->s_valid = 0;
+    top_->m_ready = 0;
+    top_->eval();
+  }
+  ~BankSim() {
+    if (trace_) trace_->close();
+    top_->final();
+  }
+  Vcorrelator_bank& top() { return *top_; }
+  void tick() {
+    top_->clk = 1;
+    top_->eval();
+    if (trace_) trace_->dump(time_++);
+    top_->clk = 0;
+    top_->eval();
+    if (trace_) trace_->dump(time_++);
+  }
+  void reset() {
+    top_->rst = 1;
+    top_->s_valid = 0;
+    tick();
+    tick();
+    top_->rst = 0;
+    top_->eval();
+  }
+  Output read() const {
+    const auto& l = design().layout;
+    const auto& c = design().config.correlator;
+    Output o;
+    for (int j = 0; j < l.codes; ++j) {
+      o.q.push_back(bits_of(top_->m_weighted, j * l.weighted_bits, l.weighted_bits));
+      o.corr_re.push_back(sext(bits_of(top_->m_corr_re, j * c.corr_bits, c.corr_bits), c.corr_bits));
+      o.corr_im.push_back(sext(bits_of(top_->m_corr_im, j * c.corr_bits, c.corr_bits), c.corr_bits));
+    }
+    o.energy = top_->m_energy;
+    o.index = top_->m_index;
+    o.chip_re = sext(top_->m_chip_re, c.chip_bits);
+    o.chip_im = sext(top_->m_chip_im, c.chip_bits);
+    return o;
+  }
+  std::uint64_t cycles() const { return time_ / 2; }
+
+ private:
+  std::unique_ptr<VerilatedContext> ctx_;
+  std::unique_ptr<Vcorrelator_bank> top_;
+  std::unique_ptr<VerilatedFstC> trace_;
+  std::uint64_t time_ = 0;
+};
+
+// First differing stage of one output, or "" when equal.
+std::string compare(const Output& e, const Output& g) {
+  std::ostringstream os;
+  if (e.chip_re != g.chip_re || e.chip_im != g.chip_im) {
+    os << "chip filter F: model (" << e.chip_re << "," << e.chip_im << ") rtl (" << g.chip_re << ","
+       << g.chip_im << ")";
+    return os.str();
+  }
+  for (std::size_t j = 0; j < e.q.size(); ++j) {
+    if (e.corr_re[j] != g.corr_re[j] || e.corr_im[j] != g.corr_im[j]) {
+      os << "combiner C code " << j + 1 << ": model (" << e.corr_re[j] << "," << e.corr_im[j]
+         << ") rtl (" << g.corr_re[j] << "," << g.corr_im[j] << ")";
+      return os.str();
+    }
+  }
+  for (std::size_t j = 0; j < e.q.size(); ++j) {
+    if (e.q[j] != g.q[j]) {
+      os << "weighted power Q code " << j + 1 << ": model " << e.q[j] << " rtl " << g.q[j];
+      return os.str();
+    }
+  }
+  if (e.energy != g.energy) {
+    os << "energy: model " << e.energy << " rtl " << g.energy;
+    return os.str();
+  }
+  if (e.index != g.index) {
+    os << "index: model " << e.index << " rtl " << g.index;
+    return os.str();
+  }
+  return "";
+}
+
+struct Totals {
+  std::uint64_t inputs = 0, outputs = 0, mismatches = 0, cycles = 0;
+  std::string first;
+};
+Totals g_totals;
+
+struct RunOpts {
+  double gap = 0.0;    // probability of no s_valid in a cycle
+  double stall = 0.0;  // probability of m_ready low
+  std::int64_t reset_after_inputs = -1;  // assert rst mid-stream after this many inputs
+};
+
+// Feeds y from reset; compares every output with the model (for a mid-stream reset: the
+// outputs before it with the first stream's model, then a fresh model on the rest).
+void run(BankSim& sim, const std::vector<std::int64_t>& y, const RunOpts& o, std::mt19937_64& rng,
+         const std::string& what) {
+  std::uniform_real_distribution<double> u(0, 1);
+  sim.reset();
+  std::vector<std::int64_t> seg = y;
+  std::size_t consumed_before_reset = 0;
+  bool did_reset = o.reset_after_inputs < 0;
+  std::vector<Output> exp = model_outputs(seg);
+  std::size_t in = 0, k = 0;
+  bool presenting = false;
+  std::uint64_t guard = 0;
+  Output held;
+  bool holding = false;
+  const std::uint64_t max_cycles = 200 * y.size() + 10000;
+  while (in < seg.size() || k < exp.size()) {
+    auto& t = sim.top();
+    if (!did_reset && static_cast<std::int64_t>(in) >= o.reset_after_inputs && u(rng) < 0.3) {
+      // Reset at an arbitrary cycle (outputs in flight are dropped): the rest is a new stream.
+      consumed_before_reset += in;
+      seg.assign(y.begin() + static_cast<std::ptrdiff_t>(in), y.end());
+      sim.reset();
+      exp = model_outputs(seg);
+      in = 0;
+      k = 0;
+      presenting = false;
+      holding = false;
+      did_reset = true;
+      continue;
+    }
+    if (!presenting && in < seg.size()) presenting = u(rng) >= o.gap;
+    t.s_valid = presenting ? 1 : 0;
+    t.s_data = static_cast<std::uint16_t>(in < seg.size() ? seg[in] : 0) & 0xffffu;
+    t.m_ready = u(rng) >= o.stall ? 1 : 0;
+    t.eval();
+    if (t.m_valid) {
+      const Output g = sim.read();
+      if (holding && !compare(held, g).empty()) {
+        ++g_totals.mismatches;
+        if (g_totals.first.empty()) g_totals.first = what + ": output changed while m_valid && !m_ready";
+      }
+      held = g;
+      holding = !t.m_ready;
+      if (t.m_ready) {
+        if (k >= exp.size()) {
+          ++g_totals.mismatches;
+          if (g_totals.first.empty()) g_totals.first = what + ": more outputs than the model";
+        } else {
+          const std::string diff = compare(exp[k], g);
+          if (!diff.empty()) {
+            ++g_totals.mismatches;
+            if (g_totals.first.empty()) {
+              g_totals.first = what + ": output " + std::to_string(k) + " (input sample " +
+                               std::to_string(exp[k].index) + "): first stage differing: " + diff;
+            }
+          }
+        }
+        ++k;
+        ++g_totals.outputs;
+      }
+    }
+    if (t.s_valid && t.s_ready) {
+      ++in;
+      presenting = false;
+    }
+    sim.tick();
+    if (++guard > max_cycles) {
+      ++g_totals.mismatches;
+      if (g_totals.first.empty()) {
+        g_totals.first = what + ": timeout after " + std::to_string(in) + " inputs, " +
+                         std::to_string(k) + " of " + std::to_string(exp.size()) + " outputs";
+      }
+      break;
+    }
+  }
+  g_totals.inputs += consumed_before_reset + in;
+  g_totals.cycles += guard;
+}
+
+TEST(CorrelatorBankRtl, BitExactOnCodedBurstsAndWorstCase) {
+  const auto& d = design();
+  ASSERT_EQ(d.family.codes.size(), 9u) << "the generated parameters hold the Gold4 codes";
+  BankSim sim;
+  std::mt19937_64 rng(12345);
+  std::uniform_real_distribution<double> u(0, 1);
+  const std::array<double, 3> distances{100, 550, 1000};
+  std::uint64_t seed = 7;
+  int case_no = 0;
+  for (std::size_t j = 0; j < d.family.codes.size(); ++j) {
+    for (double dist : distances) {
+      for (double noise : {0.0, 0.01}) {
+        std::size_t arrival = 0;
+        const auto y = filtered_burst(j, dist, noise, ++seed, &arrival);
+        // From a little before the arrival to the end: the bank sees silence, burst and tail.
+        const std::size_t start = arrival > 1100 ? arrival - 1100 : 0;
+        std::vector<std::int64_t> seg(y.begin() + static_cast<std::ptrdiff_t>(start), y.end());
+        RunOpts o;
+        if (case_no % 3 == 1) {
+          o.gap = 0.3;
+          o.stall = 0.3;
+        }
+        if (case_no % 7 == 3) o.reset_after_inputs = 1500 + case_no;
+        ++case_no;
+        run(sim, seg, o, rng,
+            "code " + std::to_string(j + 1) + " at " + std::to_string(static_cast<int>(dist)) +
+                " mm noise " + std::to_string(noise));
+      }
+    }
+  }
+  // Full-scale worst case: +-full scale in phase with the LO, chip-modulated by code 1 (largest
+  // mixer, decimator, chip filter and combiner magnitudes; saturating corr words).
+  const int data_bits = d.config.correlator.data_bits;
+  const std::int64_t top = (std::int64_t{1} << (data_bits - 1)) - 1, bottom = -top - 1;
+  for (int variant = 0; variant < 3; ++variant) {
+    std::vector<std::int64_t> y;
+    const int p = d.layout.period, nc = d.layout.chip_samples;
+    for (int rep = 0; rep < 4; ++rep) {
+      for (std::size_t c = 0; c < d.family.codes[variant].size(); ++c) {
+        for (int n = 0; n < nc; ++n) {
+          const int ph = static_cast<int>(y.size()) % p;
+          const bool pos = (ph < p / 2) == (d.family.codes[variant][c] != 0);
+          y.push_back(variant == 2 ? bottom : (pos ? top : bottom));
+        }
+      }
+    }
+    RunOpts o;
+    o.stall = variant == 1 ? 0.5 : 0.0;
+    run(sim, y, o, rng, "full-scale worst case " + std::to_string(variant));
+  }
+  // Random full-range noise with gaps, back-pressure and a mid-stream reset.
+  for (int r = 0; r < 2; ++r) {
+    std::uniform_int_distribution<std::int64_t> full(bottom, top);
+    std::vector<std::int64_t> y(12000);
+    for (auto& v : y) v = full(rng);
+    RunOpts o;
+    o.gap = 0.2 * r;
+    o.stall = 0.2 * r;
+    o.reset_after_inputs = r == 1 ? 5000 : -1;
+    run(sim, y, o, rng, "random noise " + std::to_string(r));
+  }
+  std::printf("correlator_bank: %llu input samples, %llu decimated outputs compared, %llu mismatches"
+              " (%llu cycles, %.2f cycles per input sample)\n",
+              static_cast<unsigned long long>(g_totals.inputs),
+              static_cast<unsigned long long>(g_totals.outputs),
+              static_cast<unsigned long long>(g_totals.mismatches),
+              static_cast<unsigned long long>(g_totals.cycles),
+              static_cast<double>(g_totals.cycles) / static_cast<double>(g_totals.inputs));
+  EXPECT_EQ(g_totals.mismatches, 0u) << g_totals.first;
+  EXPECT_GT(g_totals.outputs, 30000u);
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+const std::string kVc = std::string(RANGING_GENERATED_DIR) + "/rtl/correlator_bank.vc";
+const std::string kRtl = std::string(RANGING_SOURCE_DIR) + "/rtl/correlator_bank.v";
+
+TEST(CorrelatorBankRtl, VerilatorLintIsClean) {
+  const std::string log = std::string(RANGING_TRACE_DIR) + "/tb_correlator_bank_lint.log";
+  const std::string cmd = "verilator --lint-only -Wall -f " + kVc + " " + kRtl + " > " + log + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  const std::string out = slurp(log);
+  EXPECT_EQ(rc, 0) << out;
+  EXPECT_EQ(out.find("%Warning"), std::string::npos) << out;
+  EXPECT_EQ(out.find("%Error"), std::string::npos) << out;
+}
+
+// Bits of several fields packed LSB first, as hex (what $readmemh reads into one word).
+struct Packer {
+  std::vector<bool> bits;
+  void add(std::uint64_t v, int width) {
+    for (int b = 0; b < width; ++b) bits.push_back(b < 64 && ((v >> b) & 1u));
+  }
+  std::string hex() const {
+    std::string s;
+    const std::size_t digits = (bits.size() + 3) / 4;
+    for (std::size_t dd = digits; dd-- > 0;) {
+      int nib = 0;
+      for (int b = 3; b >= 0; --b) {
+        const std::size_t i = dd * 4 + static_cast<std::size_t>(b);
+        nib = nib * 2 + (i < bits.size() && bits[i] ? 1 : 0);
+      }
+      s += "0123456789abcdef"[nib];
+    }
+    return s;
+  }
+};
+
+// module iv_top instantiating the Icarus testbench with the generated parameters (.vc).
+std::string wrapper_from_vc(const std::string& tb_module, const std::vector<std::string>& extra) {
+  std::ifstream f(kVc);
+  std::string line, params;
+  for (const auto& e : extra) params += (params.empty() ? "" : ",\n    ") + e;
+  while (std::getline(f, line)) {
+    if (line.rfind("-G", 0) != 0) continue;
+    const auto eq = line.find('=');
+    params += ",\n    ." + line.substr(2, eq - 2) + "(" + line.substr(eq + 1) + ")";
+  }
+  return "module iv_top;\n  " + tb_module + " #(\n    " + params + "\n  ) tb();\nendmodule\n";
+}
+
+TEST(CorrelatorBankRtl, IcarusSimulationMatchesModel) {
+  const auto& d = design();
+  const auto& l = d.layout;
+  const auto& c = d.config.correlator;
+  std::size_t arrival = 0;
+  auto y = filtered_burst(2, 100, 0.01, 99, &arrival);
+  std::vector<std::int64_t> seg(y.begin() + static_cast<std::ptrdiff_t>(arrival - 300),
+                                y.begin() + static_cast<std::ptrdiff_t>(arrival + 1700));
+  const auto exp = model_outputs(seg);
+  const std::string dir = std::string(RANGING_TRACE_DIR) + "/iverilog_rtlbank/correlator_bank";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream vin(dir + "/in.hex"), vout(dir + "/out.hex");
+    for (std::int64_t v : seg) {
+      Packer p;
+      p.add(static_cast<std::uint64_t>(v), c.data_bits);
+      vin << p.hex() << "\n";
+    }
+    for (const auto& o : exp) {
+      Packer p;
+      for (auto q : o.q) p.add(q, l.weighted_bits);
+      p.add(o.energy, l.energy_bits);
+      p.add(o.index, 40);
+      p.add(static_cast<std::uint64_t>(o.chip_re), c.chip_bits);
+      p.add(static_cast<std::uint64_t>(o.chip_im), c.chip_bits);
+      for (auto v : o.corr_re) p.add(static_cast<std::uint64_t>(v), c.corr_bits);
+      for (auto v : o.corr_im) p.add(static_cast<std::uint64_t>(v), c.corr_bits);
+      vout << p.hex() << "\n";
+    }
+    std::ofstream w(dir + "/wrapper.v");
+    w << wrapper_from_vc("correlator_bank_iverilog_tb",
+                         {".N_IN(" + std::to_string(seg.size()) + ")", ".N_OUT(" + std::to_string(exp.size()) + ")"});
+  }
+  const std::string tb = std::string(RANGING_SOURCE_DIR) + "/tb/correlator_bank_iverilog_tb.v";
+  const std::string log = dir + "/sim.log";
+  const std::string cmd = "cd " + dir + " && iverilog -g2012 -s iv_top -o sim.vvp wrapper.v " + tb + " " +
+                          kRtl + " > " + log + " 2>&1 && vvp -n sim.vvp +vin=in.hex +vout=out.hex >> " +
+                          log + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(log);
+  const std::string out = slurp(log);
+  const auto pos = out.find("RESULT");
+  ASSERT_NE(pos, std::string::npos) << out;
+  unsigned long outputs = 0, mism = 0, xs = 0;
+  ASSERT_EQ(std::sscanf(out.c_str() + pos, "RESULT outputs=%lu mismatches=%lu xs=%lu", &outputs, &mism, &xs), 3)
+      << out;
+  std::printf("correlator_bank (Icarus): %zu input samples, %lu outputs compared, %lu mismatches\n",
+              seg.size(), outputs, mism);
+  EXPECT_EQ(outputs, exp.size()) << out;
+  EXPECT_EQ(mism, 0u) << out;
+  EXPECT_EQ(xs, 0u) << out;
+}
+
+}  // namespace
