@@ -31,6 +31,8 @@ double bessel_i0(double x) {
   return sum;
 }
 
+}  // namespace
+
 // Taps h[i] = sinc(m - mu) * kaiser(m - mu), m = i - (N/2 - 1), so that
 // y[k] = sum_i h[i] z[k - I - m] interpolates z at time k - (I + mu).
 std::vector<double> fractional_delay_taps(double mu) {
@@ -47,8 +49,6 @@ std::vector<double> fractional_delay_taps(double mu) {
   }
   return h;
 }
-
-}  // namespace
 
 std::vector<double> propagate(std::span<const double> excitation, const ChannelParams& p, double fs,
                               std::size_t n_out) {

@@ -33,6 +33,11 @@ inline constexpr int kDelayTaps = 64;              // fractional-delay interpola
 // gain in [0, 1e9], noise_rms in [0, 1e9] (transducers are checked against fs in propagate).
 void validate(const ChannelParams& p);
 
+// The interpolator's taps for a fractional delay mu in [0, 1): tap i multiplies
+// z[k - I - (i - (kDelayTaps/2 - 1))] (I = the integer delay), so the scene simulator applies
+// the same delay as propagate() to signals it assembles itself.
+std::vector<double> fractional_delay_taps(double mu);
+
 // Received signal for `excitation` sent at sample 0, sampled at fs, n_out samples long;
 // sample k is time k/fs and the true time of flight is distance_m/speed_of_sound exactly.
 // The interpolator is non-causal by kDelayTaps/2 samples: its (tiny) pre-ringing can start

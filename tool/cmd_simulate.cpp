@@ -1,6 +1,213 @@
-// Placeholder until the simulate subcommand lands; it refuses to run rather than print anything.
-#include <stdexcept>
+// `ranging simulate SCENE`: run a scene (model/scene_simulator.hpp) and write one CSV row per
+// measurement and a summary JSON. Also home of the helpers `ranging evaluate` shares
+// (tool/scene_run.hpp).
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "model/capture.hpp"
+#include "model/error.hpp"
+#include "model/scene.hpp"
+#include "model/scene_simulator.hpp"
+#include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/scene_run.hpp"
+
 namespace ranging::tool {
-int cmd_simulate(const Args&) { throw std::runtime_error("'simulate' is not implemented yet"); }
+namespace {
+
+// A progress bar that appears only when a run has lasted about two seconds.
+class Progress {
+ public:
+  Progress(std::size_t total, bool enabled)
+      : total_(total), enabled_(enabled && isatty(STDERR_FILENO)), t0_(std::chrono::steady_clock::now()) {}
+  void tick() {
+    ++done_;
+    if (!enabled_) return;
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+    if (s < 2.0 || (done_ % 16 != 0 && done_ != total_)) return;
+    const int width = 40;
+    const int fill = static_cast<int>(width * static_cast<double>(done_) / static_cast<double>(total_));
+    std::fprintf(stderr, "\r[%s%s] %zu/%zu streams, %.0f s", std::string(static_cast<std::size_t>(fill), '#').c_str(),
+                 std::string(static_cast<std::size_t>(width - fill), '.').c_str(), done_, total_, s);
+    shown_ = true;
+  }
+  ~Progress() {
+    if (shown_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  std::size_t total_, done_ = 0;
+  bool enabled_, shown_ = false;
+  std::chrono::steady_clock::time_point t0_;
+};
+
+std::string num(double v, int prec = 9) {
+  if (std::isnan(v)) return "";
+  std::ostringstream os;
+  os.precision(prec);
+  os << v;
+  return os.str();
+}
+
+nlohmann::json jnum(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+SceneRun run_scene(SceneSimulator& sim, bool quiet, const std::string& capture_dir) {
+  std::size_t total = 0;
+  for (const auto& f : sim.scene().excitation.families) total += sim.streams(f);
+  Progress bar(total, !quiet);
+  SceneRun out;
+  for (const auto& f : sim.scene().excitation.families) {
+    std::size_t fa = 0;
+    std::uint64_t ovf = 0;
+    auto capture = [&](const CaptureStream& c) {
+      Capture cap;
+      cap.sample_rate = c.fs;
+      cap.samples = *c.volts;
+      std::ostringstream name;
+      name << capture_dir << "/" << c.family << "_" << std::llround(c.distance_m * 1e3) << "mm_r" << c.repeat;
+      if (c.code > 0) name << "_j" << c.code;
+      write_file_atomic(name.str() + ".csv", capture_csv(cap));
+      write_file_atomic(name.str() + ".wav", capture_wav(cap, WavFormat::Float32));
+    };
+    auto rows = sim.run(f, [&] { bar.tick(); },
+                        capture_dir.empty() ? std::function<void(const CaptureStream&)>{} : capture, &fa, &ovf);
+    FamilySummary s = summarize(sim.scene(), f, rows, fa);
+    s.overflows = ovf;
+    out.summaries.push_back(s);
+    out.rows.insert(out.rows.end(), rows.begin(), rows.end());
+  }
+  return out;
+}
+
+std::string measurements_csv(const SceneRun& run, double /*c*/) {
+  std::ostringstream os;
+  os << "family,repeat,burst,true_distance_m,code_sent,code_decoded,tof_s,distance_m,error_m,"
+        "rho_max,rho_submax,u,energy_v2,td_s,pearson_code,receiver_rho2\n";
+  for (const auto& r : run.rows) {
+    os << r.family << "," << r.repeat << "," << r.burst << "," << num(r.true_distance_m) << "," << r.code_sent
+       << "," << (r.detected ? r.det.code : 0) << "," << (r.detected ? num(r.det.tof_s, 12) : "") << ","
+       << (r.detected ? num(r.distance_m, 12) : "") << "," << (r.detected ? num(r.error_m, 6) : "") << ","
+       << num(r.det.rho_max, 6) << "," << num(r.det.rho_submax, 6) << "," << num(r.det.u, 6) << ","
+       << num(r.det.energy, 6) << "," << num(r.det.td_s, 6) << "," << r.det.pearson_code << ","
+       << (r.detected ? num(r.det.score, 6) : "") << "\n";
+  }
+  return os.str();
+}
+
+nlohmann::json summary_json(const SceneSimulator& sim, const SceneRun& run) {
+  const Scene& s = sim.scene();
+  nlohmann::json j;
+  j["scene"] = s.name;
+  j["file"] = s.origin;
+  j["precision"] = s.receiver.precision;
+  j["speed_of_sound"] = s.speed();
+  j["max_range_m"] = s.range_l();
+  j["stages"] = nlohmann::json::array();
+  for (const auto& st : sim.stages()) j["stages"].push_back({{"name", st.name}, {"description", st.description}});
+  j["families"] = nlohmann::json::array();
+  std::size_t n = 0, err = 0;
+  for (const auto& f : run.summaries) {
+    n += f.measurements;
+    err += f.decode_errors;
+    nlohmann::json per;
+    for (std::size_t k = 0; k < f.u_per_code.size(); ++k) {
+      per.push_back({{"code", k + 1}, {"u", jnum(f.u_per_code[k])}, {"energy_v2", jnum(f.energy_per_code[k])},
+                     {"td_s", jnum(f.td_per_code[k])}});
+    }
+    j["families"].push_back({{"family", f.family}, {"eta", f.eta}, {"measurements", f.measurements},
+                             {"decode_errors", f.decode_errors}, {"decode_error_rate", f.error_rate},
+                             {"missed", f.missed}, {"false_alarms", f.false_alarms},
+                             {"distance_rmse_m", jnum(f.rmse_m)}, {"u_min", jnum(f.u_min)},
+                             {"energy_min_v2", jnum(f.energy_min)}, {"td_max_s", jnum(f.td_max_s)},
+                             {"vmax_hz", jnum(f.vmax_hz)}, {"fixed_overflows", f.overflows}, {"per_code", per}});
+  }
+  j["decode_errors"] = err;
+  j["measurements"] = n;
+  j["decode_error_rate"] = n ? static_cast<double>(err) / static_cast<double>(n) : 0.0;
+  return j;
+}
+
+std::string stages_text(const SceneSimulator& sim) {
+  std::ostringstream os;
+  os << "stages built (" << sim.stages().size() << "):\n";
+  for (const auto& st : sim.stages()) os << "  " << st.name << ": " << st.description << "\n";
+  return os.str();
+}
+
+int cmd_simulate(const Args& args) {
+  cli::Parser p("ranging simulate",
+                "Run a scene (docs/scenes.md): build exactly the channel stages it names, send its\n"
+                "codes over its distances and decode them. Writes DIR/measurements.csv (one row per\n"
+                "measurement) and DIR/summary.json; prints the stages built and a summary.");
+  p.positional("SCENE", "scene file (YAML)");
+  p.option("--precision", "float|fixed", "receiver precision (overrides the scene's receiver.precision)");
+  p.option("--out", "DIR", "output directory (created); default out/<scene name>");
+  p.flag("--json", "print the summary JSON on stdout instead of the text summary");
+  p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
+  p.flag("--quiet", "no progress bar");
+  if (!p.parse(args)) return 0;
+  Scene scene = load_scene(p.positionals().at(0));
+  if (p.has("--precision")) {
+    const std::string prec = *p.get("--precision");
+    if (prec != "float" && prec != "fixed") {
+      throw InputError("option --precision: '" + prec + "' is not valid; valid: float, fixed");
+    }
+    scene.receiver.precision = prec;
+  }
+  const std::string out = p.get_or("--out", "out/" + scene.name);
+  const bool json = p.has("--json");
+  SceneSimulator sim(scene);
+  if (!json) std::cout << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim) << std::flush;
+
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) throw InputError("option --out: cannot create '" + out + "': " + ec.message());
+  // Captures go to a staging directory that becomes DIR/captures only when the run succeeds.
+  const std::string staging = out + "/.captures.tmp";
+  if (p.has("--write-captures")) {
+    fs::remove_all(staging, ec);
+    fs::create_directories(staging, ec);
+    if (ec) throw InputError("option --out: cannot create '" + staging + "': " + ec.message());
+  }
+  SceneRun run;
+  try {
+    run = run_scene(sim, p.has("--quiet") || json, p.has("--write-captures") ? staging : "");
+  } catch (...) {
+    fs::remove_all(staging, ec);
+    throw;
+  }
+  const nlohmann::json summary = summary_json(sim, run);
+  write_file_atomic(out + "/measurements.csv", measurements_csv(run, scene.speed()));
+  write_file_atomic(out + "/summary.json", summary.dump(2) + "\n");
+  if (p.has("--write-captures")) {
+    fs::remove_all(out + "/captures", ec);
+    fs::rename(staging, out + "/captures", ec);
+    if (ec) throw InputError("option --out: cannot move captures into place: " + ec.message());
+  }
+  if (json) {
+    std::cout << summary.dump(2) << "\n";
+  } else {
+    std::printf("\n%-8s %4s %6s %7s %10s %8s %11s %9s %9s\n", "family", "eta", "n", "errors", "rmse_mm", "u_min",
+                "energy_min", "Td_max_us", "vmax_Hz");
+    for (const auto& f : run.summaries) {
+      std::printf("%-8s %4d %6zu %7zu %10.4f %8.4f %11.4g %9.1f %9.0f\n", f.family.c_str(), f.eta, f.measurements,
+                  f.decode_errors, f.rmse_m * 1e3, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz);
+    }
+    std::printf("\nwrote %s/measurements.csv, %s/summary.json%s\n", out.c_str(), out.c_str(),
+                p.has("--write-captures") ? (", " + out + "/captures/").c_str() : "");
+  }
+  return 0;
+}
+
 }  // namespace ranging::tool
