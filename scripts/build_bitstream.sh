@@ -1,0 +1,321 @@
+#!/usr/bin/env bash
+# Builds the iCEBreaker (iCE40UP5K-SG48) bitstream of the ranging system for one configuration
+# with the open flow and writes the resource/timing summary (docs/bitstream.md):
+#   ranging generate -> yosys synth_ice40 -dsp -> nextpnr-ice40 -> icepack -> icetime
+#   + resource estimates with yosys synth_ecp5 and synth_xilinx (default and large configs)
+#   -> RESULTS/bitstream.json and RESULTS/bitstream.md
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+config="$root/configs/default.yaml"
+large="$root/configs/large.yaml"
+build="$root/build"
+out=""
+results="$root/docs/results"
+check=0
+others=1
+margin=1.10
+
+usage() {
+  cat <<EOF
+Usage: scripts/build_bitstream.sh [options]
+
+Builds the ranging system (rtl/ranging_system.v + the generated receiver) for the iCEBreaker
+(iCE40UP5K-SG48) with yosys, nextpnr-ice40, icepack and icetime, and writes the summary
+(LUT4, DFF, SB_MAC16, EBR, SPRAM, required clock, Fmax, slack; ECP5 and Xilinx estimates) to
+RESULTS/bitstream.json and RESULTS/bitstream.md.
+
+Options:
+  --config FILE     receiver configuration (default: configs/default.yaml)
+  --large FILE      second configuration for the ECP5/Xilinx estimates (default: configs/large.yaml,
+                    skipped with a note when absent)
+  --build-dir DIR   CMake build folder holding tool/ranging (default: build)
+  --out DIR         work folder for generated files, netlists, logs and the .bin
+                    (default: BUILD/bitstream)
+  --results DIR     where the summary goes (default: docs/results)
+  --no-others       skip the ECP5 and Xilinx estimates
+  --check           exit 1 unless the design meets the targets: <= 5280 LUT4, <= 8 SB_MAC16,
+                    <= 30 EBR, <= 4 SPRAM, placed and routed, Fmax >= 1.1 x the system clock
+  -h, --help        this text
+Tools (PATH): yosys, nextpnr-ice40, icepack, icetime; /usr/bin/python3 for the summary.
+EOF
+}
+
+die() { echo "build_bitstream: $*" >&2; exit 2; }
+
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --config) config=$(realpath "${2:?--config needs a FILE}"); shift 2 ;;
+    --large) large=$(realpath -m "${2:?--large needs a FILE}"); shift 2 ;;
+    --build-dir) build=$(realpath -m "${2:?--build-dir needs a DIR}"); shift 2 ;;
+    --out) out=$(realpath -m "${2:?--out needs a DIR}"); shift 2 ;;
+    --results) results=$(realpath -m "${2:?--results needs a DIR}"); shift 2 ;;
+    --no-others) others=0; shift ;;
+    --check) check=1; shift ;;
+    -h|--help) usage; exit 0 ;;
+    *) usage >&2; die "unknown option '$1'" ;;
+  esac
+done
+
+[[ -f "$config" ]] || die "--config: no file $config"
+out=${out:-"$build/bitstream"}
+for t in yosys nextpnr-ice40 icepack icetime; do
+  command -v "$t" >/dev/null || die "$t not found on PATH (scripts/install-deps.sh installs the FPGA tools)"
+done
+py=/usr/bin/python3
+[[ -x "$py" ]] || die "/usr/bin/python3 not found"
+ranging="$build/tool/ranging"
+[[ -x "$ranging" ]] || die "$ranging not found: build it first (cmake --build $build --target ranging)"
+sysgen="$build/tb/ranging_system_gen"
+
+receiver_rtl=("$root/rtl/bandpass_sos.v" "$root/rtl/correlator_bank.v" "$root/rtl/peak_detector.v")
+system_rtl=("$root/rtl/adc_interface.v" "$root/rtl/tx_scheduler.v" "$root/rtl/tof_distance.v"
+            "$root/rtl/uart_tx.v" "$root/rtl/measurement_uart.v" "$root/rtl/ranging_system.v")
+for f in "${receiver_rtl[@]}" "${system_rtl[@]}"; do
+  [[ -f "$f" ]] || die "missing RTL $f"
+done
+board="$root/boards/icebreaker"
+pcf="$board/icebreaker.pcf"
+
+mkdir -p "$out" "$results"
+log() { echo "[bitstream] $*"; }
+
+# Generated files of a configuration into $1 (receiver + system top).
+generate() {
+  local cfg=$1 dir=$2 origin
+  origin=$(realpath --relative-to="$root" "$cfg")
+  "$ranging" generate --config "$cfg" --out "$dir" --origin "$origin" >"$dir.log" 2>&1 ||
+    { cat "$dir.log" >&2; die "ranging generate failed for $cfg"; }
+  if [[ ! -f "$dir/rtl/ranging_system_top.v" ]]; then
+    # `ranging generate` does not emit the system files yet: the stand-alone generator does.
+    [[ -x "$sysgen" ]] || die "$sysgen not found (cmake --build $build --target ranging_system_gen)"
+    "$sysgen" "$cfg" "$dir-system" "$origin" >>"$dir.log" 2>&1 ||
+      { cat "$dir.log" >&2; die "system generation failed for $cfg"; }
+    cp "$dir-system/rtl/ranging_system_top.v" "$dir/rtl/"
+    cp "$dir-system/system.json" "$dir/"
+  fi
+}
+
+log "generating $(realpath --relative-to="$root" "$config")"
+gen="$out/generated"
+generate "$config" "$gen"
+sources=("${receiver_rtl[@]}" "$gen/rtl/receiver_top.v" "${system_rtl[@]}" "$gen/rtl/ranging_system_top.v")
+
+# --- iCE40 -----------------------------------------------------------------------------------
+log "yosys synth_ice40 -dsp (log: $out/yosys_ice40.log)"
+read_cmd=""
+for f in "${sources[@]}" "$board/ice40_top.v"; do read_cmd+="read_verilog -defer $f; "; done
+t0=$(date +%s)
+if ! nice yosys -q -l "$out/yosys_ice40.log" -p "$read_cmd hierarchy -top ice40_top; \
+    synth_ice40 -dsp -top ice40_top -json $out/ice40_top.json; \
+    tee -o $out/stat_ice40.txt stat; write_verilog -noattr $out/ice40_top_syn.v" >/dev/null; then
+  die "yosys failed: see $out/yosys_ice40.log"
+fi
+yosys_s=$(( $(date +%s) - t0 ))
+
+clk_mhz=$($py -c "import json,sys; print(json.load(open('$gen/system.json'))['clk_hz']/1e6)")
+freq=$($py -c "print(round($clk_mhz*$margin, 3))")
+log "nextpnr-ice40 --up5k --package sg48 --freq $freq (log: $out/nextpnr.log)"
+pnr_ok=1
+t0=$(date +%s)
+nice nextpnr-ice40 --up5k --package sg48 --pcf "$pcf" --json "$out/ice40_top.json" \
+  --asc "$out/ice40_top.asc" --freq "$freq" --report "$out/nextpnr_report.json" \
+  --timing-allow-fail --seed 1 >"$out/nextpnr.log" 2>&1 || pnr_ok=0
+pnr_s=$(( $(date +%s) - t0 ))
+bin=""
+if [[ $pnr_ok == 1 ]]; then
+  log "icepack"
+  icepack "$out/ice40_top.asc" "$out/ranging_icebreaker.bin" || die "icepack failed"
+  bin="$out/ranging_icebreaker.bin"
+  log "icetime"
+  icetime -d up5k -P sg48 -p "$pcf" -c "$clk_mhz" -t "$out/ice40_top.asc" >"$out/icetime.log" 2>&1 || true
+else
+  log "nextpnr failed (the design does not fit or route): see $out/nextpnr.log"
+fi
+
+# --- ECP5 and Xilinx estimates -----------------------------------------------------------------
+estimate() {  # family cfg_tag gen_dir
+  local fam=$1 tag=$2 dir=$3 rc=""
+  for f in "${receiver_rtl[@]}" "$dir/rtl/receiver_top.v" "${system_rtl[@]}" "$dir/rtl/ranging_system_top.v"; do
+    rc+="read_verilog -defer $f; "
+  done
+  log "yosys synth_$fam ($tag)"
+  nice yosys -q -l "$out/yosys_${fam}_$tag.log" -p "$rc hierarchy -top ranging_system_top; \
+      synth_$fam -top ranging_system_top; tee -o $out/stat_${fam}_$tag.txt stat" >/dev/null ||
+    echo "failed" >"$out/stat_${fam}_$tag.txt"
+}
+if [[ $others == 1 ]]; then
+  estimate ecp5 default "$gen"
+  estimate xilinx default "$gen"
+  if [[ -f "$large" ]]; then
+    generate "$large" "$out/generated-large"
+    estimate ecp5 large "$out/generated-large"
+    estimate xilinx large "$out/generated-large"
+  else
+    log "no $large: large-configuration estimates skipped"
+  fi
+fi
+
+# --- summary -----------------------------------------------------------------------------------
+$py - "$out" "$results" "$gen/system.json" "$bin" "$pnr_ok" "$clk_mhz" "$freq" "$check" \
+    "$(realpath --relative-to="$root" "$config")" "$yosys_s" "$pnr_s" "$root" <<'EOF'
+import json, os, re, sys, datetime
+out, results, sysjson, binpath, pnr_ok, clk, freq, check, cfg, ys, ps, root = sys.argv[1:13]
+pnr_ok, clk, freq, check = pnr_ok == "1", float(clk), float(freq), check == "1"
+
+def cells(path):
+    if not os.path.exists(path):
+        return None
+    text = open(path).read()
+    if text.strip() == "failed":
+        return "failed"
+    # the last (top, flattened) statistics block
+    block = text.split("=== design hierarchy ===")[-1] if "design hierarchy" in text else text
+    counts = {}
+    for m in re.finditer(r"^\s+(\$?[A-Za-z_][\w$]*)\s+(\d+)\s*$", block, re.M):
+        counts[m.group(1)] = counts.get(m.group(1), 0) + int(m.group(2))
+    return counts
+
+def rel(p):
+    return os.path.relpath(p, root) if p else None
+
+ice = cells(os.path.join(out, "stat_ice40.txt")) or {}
+s = json.load(open(sysjson))
+summary = {
+    "generated_by": "scripts/build_bitstream.sh",
+    "date": datetime.date.today().isoformat(),
+    "config": cfg,
+    "device": "iCE40UP5K-SG48 (iCEBreaker)",
+    "system": {k: s[k] for k in ("clk_hz", "fs", "clk_div", "period_t_samples", "measurement_rate_hz", "baud")},
+    "ice40": {
+        "lut4": ice.get("SB_LUT4", 0),
+        "dff": sum(v for k, v in ice.items() if k.startswith("SB_DFF")),
+        "carry": ice.get("SB_CARRY", 0),
+        "sb_mac16": ice.get("SB_MAC16", 0),
+        "ebr": ice.get("SB_RAM40_4K", 0),
+        "spram": ice.get("SB_SPRAM256KA", 0),
+        "unmapped_multipliers": sum(v for k, v in ice.items() if k.startswith("$mul") or k.startswith("$macc")),
+        "limits": {"lut4": 5280, "sb_mac16": 8, "ebr": 30, "spram": 4},
+        "required_clock_mhz": clk,
+        "nextpnr_target_mhz": freq,
+        "placed_and_routed": pnr_ok,
+        "bitstream": rel(binpath) if binpath else None,
+        "yosys_seconds": int(ys), "nextpnr_seconds": int(ps),
+    },
+}
+ic = summary["ice40"]
+if pnr_ok:
+    rep = json.load(open(os.path.join(out, "nextpnr_report.json")))
+    util = rep.get("utilization", {})
+    ic["logic_cells"] = util.get("ICESTORM_LC", {}).get("used")
+    fm = rep.get("fmax", {})
+    best = None
+    for name, v in fm.items():
+        if best is None or v["achieved"] < best[1]["achieved"]:
+            best = (name, v)
+    if best:
+        ic["fmax_mhz"] = round(best[1]["achieved"], 2)
+        ic["fmax_clock"] = best[0]
+        ic["slack_ns"] = round(1e3 / clk - 1e3 / best[1]["achieved"], 3)
+        ic["margin_percent"] = round((best[1]["achieved"] / clk - 1) * 100, 1)
+    it = os.path.join(out, "icetime.log")
+    if os.path.exists(it):
+        m = re.search(r"Total path delay:\s*([\d.]+)\s*ns\s*\(([\d.]+)\s*MHz\)", open(it).read())
+        if m:
+            ic["icetime_path_ns"] = float(m.group(1))
+            ic["icetime_fmax_mhz"] = float(m.group(2))
+else:
+    log = open(os.path.join(out, "nextpnr.log")).read()
+    errs = [l for l in log.splitlines() if "ERROR" in l]
+    ic["nextpnr_error"] = errs[-1] if errs else "nextpnr failed"
+
+def fam_summary(fam, counts):
+    if counts is None:
+        return None
+    if counts == "failed":
+        return {"status": "yosys failed"}
+    if fam == "ecp5":
+        return {"lut4": counts.get("LUT4", 0),
+                "ff": counts.get("TRELLIS_FF", 0),
+                "dsp_mult18": counts.get("MULT18X18D", 0),
+                "bram_dp16kd": counts.get("DP16KD", 0),
+                "lutram_dpr16x4": counts.get("TRELLIS_DPR16X4", 0)}
+    return {"lut": sum(v for k, v in counts.items() if re.fullmatch(r"LUT\d", k)),
+            "ff": sum(v for k, v in counts.items() if re.fullmatch(r"FD[A-Z]{1,2}", k)),
+            "dsp48e1": counts.get("DSP48E1", 0),
+            "ramb18": counts.get("RAMB18E1", 0), "ramb36": counts.get("RAMB36E1", 0),
+            "lutram": sum(v for k, v in counts.items() if k.startswith("RAM") and "B" not in k[:4])}
+
+others = {}
+for tag in ("default", "large"):
+    for fam in ("ecp5", "xilinx"):
+        r = fam_summary(fam, cells(os.path.join(out, f"stat_{fam}_{tag}.txt")))
+        if r is not None:
+            others.setdefault(tag, {})[fam] = r
+summary["other_families"] = others
+
+fails = []
+lim = ic["limits"]
+for k in ("lut4", "sb_mac16", "ebr", "spram"):
+    if ic[k] > lim[k]:
+        fails.append(f"{k} {ic[k]} > {lim[k]} (over by {ic[k] - lim[k]}, {100 * (ic[k] / lim[k] - 1):.0f} %)")
+if ic["unmapped_multipliers"]:
+    fails.append(f"{ic['unmapped_multipliers']} multipliers not mapped to SB_MAC16 (in LUTs)")
+if not pnr_ok:
+    fails.append("not placed and routed: " + ic["nextpnr_error"])
+elif ic.get("fmax_mhz", 0) < clk * 1.1:
+    fails.append(f"Fmax {ic.get('fmax_mhz')} MHz < {clk * 1.1:.1f} MHz (required clock + 10 %)")
+summary["targets_met"] = not fails
+summary["target_failures"] = fails
+
+os.makedirs(results, exist_ok=True)
+with open(os.path.join(results, "bitstream.json"), "w") as f:
+    json.dump(summary, f, indent=2)
+    f.write("\n")
+
+def v(x):
+    return "-" if x is None else str(x)
+md = [f"# Bitstream summary ({cfg})", "",
+      f"Written by `scripts/build_bitstream.sh` on {summary['date']}; do not edit by hand.", "",
+      f"System: clock {clk:g} MHz, fs {s['fs']/1e6:g} MS/s ({s['clk_div']} clocks per sample), burst period "
+      f"{s['period_t_samples']} samples ({s['measurement_rate_hz']:.0f} measurements/s), UART {s['baud']/1e6:g} Mbaud.", "",
+      "## iCE40UP5K-SG48 (yosys synth_ice40 -dsp, nextpnr-ice40)", "",
+      "| resource | used | available |", "|---|---|---|",
+      f"| LUT4 (SB_LUT4) | {ic['lut4']} | 5280 |",
+      f"| logic cells (nextpnr) | {v(ic.get('logic_cells'))} | 5280 |",
+      f"| DFF | {ic['dff']} | 5280 |",
+      f"| SB_CARRY | {ic['carry']} | - |",
+      f"| SB_MAC16 | {ic['sb_mac16']} | 8 |",
+      f"| EBR (SB_RAM40_4K) | {ic['ebr']} | 30 |",
+      f"| SPRAM | {ic['spram']} | 4 |",
+      f"| multipliers left in LUTs | {ic['unmapped_multipliers']} | 0 |", "",
+      "| timing | value |", "|---|---|",
+      f"| required clock | {clk:g} MHz |",
+      f"| nextpnr target (--freq) | {freq:g} MHz |",
+      f"| placed and routed | {'yes' if pnr_ok else 'no: ' + ic.get('nextpnr_error', '')} |",
+      f"| Fmax (nextpnr) | {v(ic.get('fmax_mhz'))} MHz |",
+      f"| slack at the required clock | {v(ic.get('slack_ns'))} ns |",
+      f"| margin | {v(ic.get('margin_percent'))} % |",
+      f"| icetime critical path | {v(ic.get('icetime_path_ns'))} ns ({v(ic.get('icetime_fmax_mhz'))} MHz) |",
+      f"| bitstream | {v(ic['bitstream'])} |", ""]
+if others:
+    md += ["## Other families (yosys estimates of ranging_system_top, no place and route)", "",
+           "| configuration | family | LUT | FF | DSP | block RAM |", "|---|---|---|---|---|---|"]
+    for tag, fams in others.items():
+        for fam, r in fams.items():
+            if "status" in r:
+                md.append(f"| {tag} | {fam} | {r['status']} | | | |")
+            elif fam == "ecp5":
+                md.append(f"| {tag} | ECP5 | {r['lut4']} | {r['ff']} | {r['dsp_mult18']} MULT18X18D | {r['bram_dp16kd']} DP16KD |")
+            else:
+                md.append(f"| {tag} | Xilinx 7 | {r['lut']} | {r['ff']} | {r['dsp48e1']} DSP48E1 | {r['ramb18']} RAMB18 + {r['ramb36']} RAMB36 |")
+    if "large" not in others:
+        md.append("| large | - | no configs/large.yaml yet | | | |")
+    md.append("")
+md += ["## Targets", "",
+       "Met." if not fails else "Not met:\n\n" + "\n".join(f"- {x}" for x in fails), ""]
+with open(os.path.join(results, "bitstream.md"), "w") as f:
+    f.write("\n".join(md))
+print("\n".join(md))
+sys.exit(1 if (check and fails) else 0)
+EOF
