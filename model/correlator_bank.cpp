@@ -138,7 +138,7 @@ CorrelatorFixedLayout resolve_correlator_layout(const CorrelatorReference& ref,
                                        ref.corr_peak * front * std::exp2(-l.chip_shift)))) -
                                        (cfg.corr_bits - 2));
   require_in_range("correlator_fixed.corr_shift", l.corr_shift, 0, l.comb_bits);
-  l.power_bits = 2 * cfg.corr_bits - 1;
+  l.power_bits = 2 * cfg.corr_bits;  // Re = Im = -2^(corr_bits-1) gives P = 2^(2 corr_bits - 1)
   l.weighted_bits = l.power_bits + cfg.weight_bits;
   l.energy_bits = 2 * cfg.data_bits - 1 + ceil_log2(ref.window);
   if (l.energy_bits > 63 || l.weighted_bits > 63) {

@@ -74,7 +74,7 @@ struct CorrelatorFixedLayout {
   int chip_shift = 0;      // F_q = round(F / 2^chip_shift), chip_bits wide
   int comb_bits = 0;       // C: chip_bits + ceil(log2 L), exact
   int corr_shift = 0;      // C_q = round(C / 2^corr_shift), corr_bits wide
-  int power_bits = 0;      // P: 2 corr_bits - 1, unsigned, exact
+  int power_bits = 0;      // P: 2 corr_bits, unsigned, exact (holds 2 (2^(corr_bits-1))^2)
   int weighted_bits = 0;   // Q = P w: power_bits + weight_bits, unsigned, exact
   int energy_bits = 0;     // E: 2 data_bits - 1 + ceil(log2 W), unsigned, exact
   int energy_shift = 0;    // norm = E >> energy_shift

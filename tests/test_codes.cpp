@@ -1,6 +1,8 @@
 // Code generators: the paper's printed tables, m-sequence and Gold-code properties from
 // theory (not from the implementation), input refusal, and the `ranging codes` CLI.
 #include <gtest/gtest.h>
+
+#include "tests/process.hpp"
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -442,32 +444,8 @@ TEST(Families, NamesAndErrors) {
 // ---------------------------------------------------------------------------------------------
 // The CLI, run as a process.
 
-namespace {
-
-struct ToolRun {
-  int status = -1;
-  std::string out, err;
-};
-
-ToolRun run_tool(const std::string& args) {
-  const std::string err_path = testing::TempDir() + "test_codes_stderr.txt";
-  const std::string cmd = std::string("\"") + RANGING_TOOL + "\" " + args + " 2>\"" + err_path + "\"";
-  ToolRun r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[4096];
-  std::size_t got = 0;
-  while ((got = fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, got);
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  std::ifstream ef(err_path);
-  std::stringstream ss;
-  ss << ef.rdbuf();
-  r.err = ss.str();
-  return r;
-}
-
-}  // namespace
+using ToolRun = ranging::testing_support::ProcessResult;
+using ranging::testing_support::run_tool;
 
 TEST(Cli, ListsPaperFamilies) {
   const ToolRun r = run_tool("codes --list");

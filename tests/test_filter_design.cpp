@@ -2,6 +2,8 @@
 // spec, the fixed-point section structure (pairing, ordering, L-infinity scaling) and the CLI.
 #include <gtest/gtest.h>
 
+#include "tests/process.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,30 +25,10 @@ namespace {
 constexpr FilterType kTypes[] = {FilterType::Butterworth, FilterType::Chebyshev1,
                                  FilterType::Elliptic};
 
-struct Proc {
-  int status = -1;
-  std::string out, err;
-};
+using Proc = testing_support::ProcessResult;
+using testing_support::run_command;
 
-// Runs a shell command, capturing stdout and stderr.
-Proc run(const std::string& cmd) {
-  const auto err_path = std::filesystem::temp_directory_path() /
-                        ("ranging_filter_test_" + std::to_string(::getpid()) + ".err");
-  Proc r;
-  FILE* pipe = ::popen((cmd + " 2>" + err_path.string()).c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
-  const int st = ::pclose(pipe);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  std::ifstream ef(err_path);
-  std::stringstream ss;
-  ss << ef.rdbuf();
-  r.err = ss.str();
-  std::filesystem::remove(err_path);
-  return r;
-}
+Proc run(const std::string& cmd) { return run_command(cmd); }
 
 std::string num(double v) {
   char buf[40];

@@ -4,10 +4,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
 
 #include "model/error.hpp"
+#include "tests/process.hpp"
 #include "model/hw_generator.hpp"
 #include "model/hw_params.hpp"
 
@@ -16,26 +18,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct ToolRun {
-  int status;
-  std::string out, err;
-};
-
-ToolRun run_tool(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / ("gen_err_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(RANGING_TOOL) + " " + args + " 2>" + err.string();
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, pipe.get())) > 0) out.append(buf, n);
-  const int status = pclose(pipe.release());
-  std::ifstream e(err);
-  std::stringstream ss;
-  ss << e.rdbuf();
-  fs::remove(err);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, ss.str()};
-}
+using ToolRun = testing_support::ProcessResult;
+using testing_support::run_tool;
 
 fs::path temp_dir(const std::string& name) {
   const fs::path p = fs::temp_directory_path() / ("ranging_gen_" + name + "_" + std::to_string(::getpid()));
@@ -132,4 +116,35 @@ TEST(Generate, AFailedRunLeavesAPreviousOutputUntouched) {
   EXPECT_TRUE(fs::exists(out / "marker"));
   fs::remove_all(out);
   fs::remove(cfg);
+}
+
+// The committed generated/default/ is exactly what the generator writes for configs/default.yaml:
+// generated files are never edited by hand.
+TEST(Generate, CommittedDefaultIsUpToDate) {
+  const fs::path out = temp_dir("committed");
+  const fs::path committed = fs::path(RANGING_SOURCE_DIR) / "generated/default";
+  const ToolRun r = run_tool("generate --config " + std::string(RANGING_SOURCE_DIR) +
+                             "/configs/default.yaml --out " + out.string() + " --origin configs/default.yaml");
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto files = [](const fs::path& root) {
+    std::map<std::string, std::string> m;
+    for (const auto& e : fs::recursive_directory_iterator(root)) {
+      if (!e.is_regular_file()) continue;
+      std::ifstream f(e.path(), std::ios::binary);
+      std::stringstream ss;
+      ss << f.rdbuf();
+      m[fs::relative(e.path(), root).string()] = ss.str();
+    }
+    return m;
+  };
+  const auto fresh = files(out), old = files(committed);
+  for (const auto& [name, text] : fresh) {
+    ASSERT_TRUE(old.count(name)) << "generated/default/" << name << " is missing: regenerate";
+    EXPECT_EQ(old.at(name), text) << "generated/default/" << name
+                                  << " differs from the generator's output: regenerate, never edit by hand";
+  }
+  for (const auto& [name, text] : old) {
+    EXPECT_TRUE(fresh.count(name)) << "generated/default/" << name << " is not generated any more";
+  }
+  fs::remove_all(out);
 }

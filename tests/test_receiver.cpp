@@ -8,27 +8,15 @@
 
 #include "model/demo.hpp"
 #include "model/error.hpp"
+#include "tests/process.hpp"
 #include "model/receiver.hpp"
 
 using namespace ranging;
 
 namespace {
 
-struct ToolRun {
-  int status;
-  std::string out;
-};
-
-ToolRun run_tool(const std::string& args) {
-  const std::string cmd = std::string(RANGING_TOOL) + " " + args + " 2>/dev/null";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, pipe.get())) > 0) out.append(buf, n);
-  const int status = pclose(pipe.release());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using ToolRun = testing_support::ProcessResult;
+using testing_support::run_tool;
 
 std::string error_of(const std::string& yaml) {
   try {
