@@ -15,3 +15,8 @@ target_compile_definitions(tb_bandpass_sos PRIVATE
 # Verilator's runtime headers are not ours: include them as system headers so -Werror on the
 # testbench does not trip over their warnings (GCC drops the plain -I of the same directory).
 target_include_directories(tb_bandpass_sos SYSTEM PRIVATE ${VERILATOR_ROOT}/include ${VERILATOR_ROOT}/include/vltstd)
+# tb/CMakeLists.txt replaces the directory's compile options (dropping -fsanitize): put the
+# sanitizers back on this testbench so RANGING_SANITIZE=ON checks its code too.
+if(RANGING_SANITIZE)
+  target_compile_options(tb_bandpass_sos PRIVATE -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+endif()
