@@ -145,6 +145,7 @@ Measurement32 TofDistanceModel::execute(int code, std::int64_t arrival, std::uin
   std::int64_t t = last_time_ - static_cast<std::int64_t>(k) * s_.period_t;
   const std::int64_t cycle = static_cast<std::int64_t>(s_.codes) * s_.period_t;
   std::int64_t tof = 0;
+  if (t < 0) no_tx = true;  // the code's burst would precede the first one: never sent
   while (!no_tx) {
     tof = a - t * (std::int64_t{1} << s_.frac_w);
     if (tof >= 0) break;

@@ -17,7 +17,8 @@
 //                    t_j 2^FRAC_W <= A: from the last burst (time S, code c)
 //                    t_j = S - ((c - j) mod CODES) PERIOD_T, then minus
 //                    CODES PERIOD_T while A - t_j 2^FRAC_W < 0 (the schedule is
-//                    strictly periodic, so no per-code table is needed)
+//                    strictly periodic, so no per-code table is needed); t_j < 0
+//                    means the code was never sent (flag)
 //              ToF = A - t_j 2^FRAC_W     unsigned TOF_W, FRAC_W fraction bits
 //                                         (full-rate samples), saturated
 //              distance = (ToF * C + 2^(FRAC_W+C_FRAC-1)) >> (FRAC_W+C_FRAC)
@@ -159,6 +160,8 @@ module tof_distance #(
           if (no_tx) begin
             mplier <= 0;
             state <= MUL;
+          end else if (t < 0) begin
+            no_tx <= 1'b1;  // code j's burst would precede the first one: never sent
           end else if (tof_w < 0) begin
             if (t < CYCLE) no_tx <= 1'b1;
             else t <= t - CYCLE;

@@ -38,3 +38,40 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v AND EXISTS ${RANGING_SYSTEM_
     TB ${CMAKE_CURRENT_SOURCE_DIR}/tb_ranging_system.cpp)
   target_compile_definitions(tb_ranging_system PRIVATE RANGING_TB_CLK_DIV=${RANGING_TB_CLK_DIV_VALUE})
 endif()
+
+# Post-synthesis equivalence: the synthesized receiver netlist against the golden model (Icarus).
+find_program(RANGING_YOSYS_BIN yosys)
+find_program(RANGING_PS_IVERILOG iverilog)
+find_program(RANGING_PS_VVP vvp)
+if(RANGING_YOSYS_BIN AND RANGING_PS_IVERILOG AND EXISTS ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v)
+  execute_process(COMMAND yosys-config --datdir OUTPUT_VARIABLE RANGING_YOSYS_DATDIR OUTPUT_STRIP_TRAILING_WHITESPACE)
+  add_executable(tb_postsynth ${CMAKE_CURRENT_SOURCE_DIR}/tb_postsynth.cpp)
+  set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/tb_postsynth.cpp PROPERTIES
+    COMPILE_OPTIONS "$<$<BOOL:${RANGING_WERROR}>:-Werror>")
+  target_link_libraries(tb_postsynth PRIVATE ranging_model GTest::gtest GTest::gtest_main)
+  target_include_directories(tb_postsynth PRIVATE ${PROJECT_SOURCE_DIR})
+  target_compile_definitions(tb_postsynth PRIVATE
+    RANGING_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    RANGING_GENERATED_DIR="${RANGING_GEN_DEFAULT}"
+    RANGING_CONFIG="${PROJECT_SOURCE_DIR}/configs/default.yaml"
+    RANGING_YOSYS_BIN="${RANGING_YOSYS_BIN}"
+    RANGING_YOSYS_DATDIR="${RANGING_YOSYS_DATDIR}"
+    RANGING_IVERILOG_BIN="${RANGING_PS_IVERILOG}"
+    RANGING_VVP_BIN="${RANGING_PS_VVP}"
+    RANGING_POSTSYNTH_WORK_DIR="${CMAKE_CURRENT_BINARY_DIR}/postsynth")
+  add_test(NAME postsynth_equivalence COMMAND tb_postsynth)
+  set_tests_properties(postsynth_equivalence PROPERTIES LABELS "bitstream" TIMEOUT 3600)
+endif()
+
+# The bitstream of the default configuration: `cmake --build BUILD --target bitstream` writes
+# docs/results/bitstream.{json,md}; the ctest entry (label "bitstream") builds it into the
+# build tree and fails unless the targets of docs/bitstream.md are met.
+add_custom_target(bitstream
+  COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR}
+  DEPENDS ranging ranging_system_gen
+  WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+  USES_TERMINAL)
+add_test(NAME bitstream_targets
+  COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR}
+          --out ${CMAKE_BINARY_DIR}/bitstream-test --results ${CMAKE_BINARY_DIR}/bitstream-test/results --check)
+set_tests_properties(bitstream_targets PROPERTIES LABELS "bitstream" TIMEOUT 7200)

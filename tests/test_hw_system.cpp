@@ -1,0 +1,117 @@
+// The ranging system's generated parameters (model/hw_system.hpp): burst period from eq. 3/4,
+// transmit drive, time of flight model, refusals, and the committed generated system files.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "model/error.hpp"
+#include "model/excitation.hpp"
+#include "model/hw_system.hpp"
+#include "model/metrics.hpp"
+#include "model/receiver.hpp"
+
+using namespace ranging;
+
+namespace {
+
+const ReceiverDesign& design() {
+  static const ReceiverDesign d =
+      design_receiver(load_receiver_config(std::string(RANGING_SOURCE_DIR) + "/configs/default.yaml"));
+  return d;
+}
+const SystemDesign& sys() {
+  static const SystemDesign s = system_design(design());
+  return s;
+}
+
+TEST(HwSystem, PeriodFollowsEquations3And4) {
+  const auto& s = sys();
+  const double c = s.speed_of_sound, l = s.max_range_m;
+  // eq. 3: eta codes cover the longest flight; eq. 4's other bound: T >= 1.5 T_d.
+  EXPECT_GE(eta_required(l, s.period_t / s.fs, c), 1);
+  EXPECT_LE(eta_required(l, s.period_t / s.fs, c), s.codes);
+  EXPECT_GE(s.period_t, 1.5 * design().layout.window);
+  // The rate is eq. 4's v_max up to the rounding of T to whole samples (the paper's Table 6
+  // gives 3060 Hz for Gold codes at L = 1 m).
+  const double v = vmax(design().layout.window / s.fs, s.codes, c, l);
+  EXPECT_LE(s.measurement_rate_hz(), v + 1e-9);
+  EXPECT_GT(s.measurement_rate_hz(), s.fs / (s.fs / v + 1));
+  EXPECT_EQ(s.clk_div, 9);
+  EXPECT_EQ(s.baud_div, 30);
+}
+
+TEST(HwSystem, DriveIsTheScheduleOfHbridgeBursts) {
+  const auto& d = design();
+  const auto& s = sys();
+  const std::size_t n = static_cast<std::size_t>(s.period_t) * (s.codes + 1);
+  const auto drive = system_drive(d, s, n);
+  ExcitationParams ex;
+  ex.carrier_hz = d.config.carrier_hz;
+  ex.cycles_per_chip = d.config.cycles_per_chip;
+  ex.fs = d.config.fs;
+  for (int b = 0; b <= s.codes; ++b) {
+    const auto h = hbridge_drive(d.family.codes[static_cast<std::size_t>(b % s.codes)], ex);
+    const std::size_t start = static_cast<std::size_t>(b) * s.period_t;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(s.period_t); ++i) {
+      const int want = i < h.size() ? h[i] : 0;
+      ASSERT_EQ(drive[start + i], want) << "burst " << b << " sample " << i;
+    }
+  }
+}
+
+TEST(HwSystem, TimeOfFlightUsesTheMostRecentBurstOfTheCode) {
+  const auto& s = sys();
+  TofDistanceModel m(s);
+  const std::int64_t t = s.period_t, one = std::int64_t{1} << s.frac_w;
+  // Bursts 0..10 sent (codes 1..9, 1, 2); an arrival of code 3 sent at 2T, 4000.5 samples later,
+  // reported after burst 10 (code 2): it must use burst 2, not a later or earlier one.
+  for (int b = 0; b <= 10; ++b) m.burst(b % s.codes + 1, b * t);
+  const std::int64_t arrival = (2 * t + 4000) * one + one / 2 + s.offsets[2];
+  const auto r = m.execute(3, arrival, 1, 2);
+  EXPECT_EQ(r.flags, 0u);
+  EXPECT_EQ(r.tof, static_cast<std::uint32_t>(4000 * one + one / 2));
+  EXPECT_EQ(r.distance, 272034u);  // 4000.5 samples * 68 um, rounded
+  // Code 1 arriving after its second burst (9T) uses that one.
+  const auto r1 = m.execute(1, (9 * t + 100) * one + s.offsets[0], 0, 0);
+  EXPECT_EQ(r1.tof, static_cast<std::uint32_t>(100 * one));
+  // An arrival before any burst of its code was sent is flagged.
+  TofDistanceModel early(s);
+  early.burst(1, 0);
+  EXPECT_EQ(early.execute(5, 3000 * one + s.offsets[4], 0, 0).flags, 1u);
+}
+
+TEST(HwSystem, RefusesClocksThatAreNotMultiplesOfTheSampleRate) {
+  SystemOptions o;
+  o.clk_hz = 47e6;
+  try {
+    system_design(design(), o);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("clk_hz"), std::string::npos) << e.what();
+  }
+  o = {};
+  o.baud = 1e6 + 1;
+  EXPECT_THROW(system_design(design(), o), InputError);
+  o = {};
+  o.speed_of_sound = 5;
+  EXPECT_THROW(system_design(design(), o), InputError);
+}
+
+// The committed generated/default-system files are what the generator writes now.
+TEST(HwSystem, CommittedFilesAreUpToDate) {
+  const auto files = generate_system_files(design(), "configs/default.yaml");
+  EXPECT_EQ(files.size(), 3u);
+  for (const auto& [name, text] : files) {
+    const auto path = std::filesystem::path(RANGING_SOURCE_DIR) / "generated/default-system" / name;
+    std::ifstream f(path);
+    ASSERT_TRUE(f) << path;
+    std::stringstream ss;
+    ss << f.rdbuf();
+    EXPECT_EQ(ss.str(), text) << name << " is stale: rerun ranging_system_gen configs/default.yaml "
+                                         "generated/default-system configs/default.yaml";
+  }
+}
+
+}  // namespace
