@@ -226,7 +226,8 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
     r.get_range("cycles_per_chip", e.cycles_per_chip, 1, 64);
     r.get_range("carrier_hz", e.carrier_hz, 1e3, 10e6);
     section(r, "cycles_per_chip_by_family", [&](Reader& q) {
-      for (const auto& name : e.families) {
+      // Any family name (a family the scene does not send is harmless); others are unknown keys.
+      for (const auto& name : code_family_names()) {
         int v = 0;
         if (q.get_range(name, v, 1, 64)) e.cycles_per_chip_by_family[name] = v;
       }

@@ -33,7 +33,7 @@ int cmd_decode(const Args& args) {
   p.option("--speed-of-sound", "M/S", "speed of sound, 100..10000 (default 340)");
   p.option("--temperature", "C", "air temperature -40..60 C: speed of sound at 50 % RH, 101.325 kPa");
   p.option("--period", "S", "bursts were sent every S seconds, codes 1..eta in turn (default: one burst per code, all at t = 0)");
-  p.option("--min-rho", "R", "report bursts whose Pearson rho_max (eq. 9) is at least R, 0..1 (noise triggers score lower)", "0.5");
+  p.option("--min-rho", "R", "report bursts whose Pearson rho_max (eq. 9) is at least R, 0..1 (noise triggers score lower)", "0.7");
   p.flag("--json", "machine-readable output");
   if (!p.parse(args)) return 0;
   if (!p.has("--family")) throw InputError("option --family: required (ranging codes --list)");
@@ -53,7 +53,7 @@ int cmd_decode(const Args& args) {
     c = speed_of_sound(a);
   }
   const double period = p.number("--period", 0, 0, 10);
-  const double min_rho = p.number("--min-rho", 0.5, 0, 1);
+  const double min_rho = p.number("--min-rho", 0.7, 0, 1);
   const std::string path = p.positionals().at(0);
   Capture cap = read_capture(path);
 

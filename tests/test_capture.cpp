@@ -1,0 +1,229 @@
+// Captures: CSV/WAV readers and writers, `ranging decode`, the simulate -> capture -> decode
+// round trip, and every bad-capture case (clear error naming file and line, exit 2, no output).
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "model/capture.hpp"
+#include "model/error.hpp"
+
+using namespace ranging;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ToolRun {
+  int status;
+  std::string out, err;
+};
+ToolRun run_tool(const std::string& args) {
+  const std::string errfile = ::testing::TempDir() + "/capture_stderr.txt";
+  const std::string cmd = std::string(RANGING_TOOL) + " " + args + " 2>" + errfile;
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, pipe.get())) > 0) out.append(buf, n);
+  const int status = pclose(pipe.release());
+  std::ifstream e(errfile);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, ss.str()};
+}
+
+std::string sci(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.9e", v);
+  return b;
+}
+
+void write(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string error_of_csv(const std::string& text) {
+  try {
+    parse_capture_csv(text, "cap.csv");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Capture, CsvAndWavRoundTripInEveryFormat) {
+  Capture c;
+  c.sample_rate = 5e6;
+  for (int n = 0; n < 1000; ++n) c.samples.push_back(0.7 * std::sin(n * 0.251) * std::exp(-n / 400.0));
+  const Capture csv = parse_capture_csv(capture_csv(c), "x.csv");
+  EXPECT_NEAR(csv.sample_rate, 5e6, 1e-3);
+  EXPECT_EQ(csv.t0, 0.0);
+  ASSERT_EQ(csv.samples.size(), c.samples.size());
+  for (std::size_t n = 0; n < c.samples.size(); ++n) EXPECT_NEAR(csv.samples[n], c.samples[n], 1e-9);
+  for (auto [fmt, tol] : {std::pair{WavFormat::Pcm16, 1.0 / 32768}, std::pair{WavFormat::Pcm24, 1.0 / 8388608},
+                          std::pair{WavFormat::Float32, 1e-7}}) {
+    const Capture w = parse_capture_wav(capture_wav(c, fmt), "x.wav");
+    EXPECT_EQ(w.sample_rate, 5e6);
+    ASSERT_EQ(w.samples.size(), c.samples.size());
+    for (std::size_t n = 0; n < c.samples.size(); ++n) EXPECT_NEAR(w.samples[n], c.samples[n], tol);
+  }
+}
+
+TEST(Capture, TektronixStyleHeaderAndNegativeStartTime) {
+  std::string text =
+      "Model,MDO3024\nFirmware Version,1.26\n\nWaveform Type,ANALOG\nSample Interval,2e-07\n"
+      "Record Length,5\nTIME,CH1\n";
+  for (int n = 0; n < 5; ++n) text += sci(-4e-7 + n * 2e-7) + "," + std::to_string(0.1 * n) + "\n";
+  const Capture c = parse_capture_csv(text, "tek.csv");
+  EXPECT_NEAR(c.sample_rate, 5e6, 1.0);
+  EXPECT_NEAR(c.t0, -4e-7, 1e-12);
+  EXPECT_EQ(c.samples.size(), 5u);
+}
+
+TEST(Capture, BadCsvNamesFileAndLine) {
+  const std::string head = "TIME,CH1\n0,0\n2e-7,0.1\n";
+  auto has = [](const std::string& text, const std::string& what) {
+    const std::string e = error_of_csv(text);
+    EXPECT_NE(e.find(what), std::string::npos) << "error '" << e << "'";
+  };
+  has("", "cap.csv:0: no data rows");
+  has("TIME,CH1\n", "cap.csv:1: no data rows");
+  has(head + "4e-7,abc\n", "cap.csv:4: voltage column: 'abc' is not a number");
+  has(head + "4e-7,nan\n", "cap.csv:4: voltage column: 'nan' is not finite");
+  has(head + "inf,0.1\n", "cap.csv:4: time column: 'inf' is not finite");
+  has(head + "1e-7,0.1\n", "cap.csv:4: time does not increase");
+  has(head + "6e-7,0.1\n8e-7,0\n1e-6,0\n", "uneven sampling");
+  has(head + "4e-7\n", "cap.csv:4: expected 'time,voltage'");
+}
+
+TEST(Capture, BadWavIsRefusedWithByteOffset) {
+  Capture c;
+  c.sample_rate = 5e6;
+  c.samples.assign(100, 0.25);
+  const std::string good = capture_wav(c, WavFormat::Pcm16);
+  auto err = [](const std::string& bytes) {
+    try {
+      parse_capture_wav(bytes, "cap.wav");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(err(good.substr(0, good.size() - 10)).find("cap.wav: byte 36: truncated"), std::string::npos);
+  EXPECT_NE(err(good.substr(0, 30)).find("truncated"), std::string::npos);
+  EXPECT_NE(err("").find("empty"), std::string::npos);
+  EXPECT_NE(err("RIFX0000WAVE").find("not a RIFF/WAVE"), std::string::npos);
+  std::string bits8 = good;
+  bits8[34] = 8;  // bits per sample
+  EXPECT_NE(err(bits8).find("unsupported sample format"), std::string::npos);
+}
+
+// simulate --write-captures, then decode every capture back: same code, same distance.
+TEST(DecodeCli, DecodesSimulatedCapturesBackToTheSimulatedResults) {
+  const std::string dir = ::testing::TempDir() + "/capture_rt";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scene = dir + "/rt.yaml";
+  write(scene,
+        "name: rt\ntransducers: {}\ngeometry:\n  distances_m: [0.25, 0.9]\nexcitation:\n  family: M1\n"
+        "  codes: [3, 6]\nnoise:\n  noise_v: 0.002\n  seed: 11\n");
+  const ToolRun sim = run_tool("simulate " + scene + " --out " + dir + "/out --write-captures --quiet --json");
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  std::ifstream csv(dir + "/out/measurements.csv");
+  std::string line;
+  std::getline(csv, line);
+  int checked = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cell;
+    std::stringstream ss(line);
+    std::string x;
+    while (std::getline(ss, x, ',')) cell.push_back(x);
+    const double d = std::stod(cell[3]);
+    const int code = std::stoi(cell[4]);
+    const double tof = std::stod(cell[6]), rho = std::stod(cell[9]);
+    const std::string stem = dir + "/out/captures/M1_" + std::to_string(std::lround(d * 1e3)) + "mm_r1_j" + std::to_string(code);
+    for (const char* ext : {".csv", ".wav"}) {
+      const ToolRun dec = run_tool("decode " + stem + ext + " --family M1 --json");
+      ASSERT_EQ(dec.status, 0) << dec.err;
+      const auto j = nlohmann::json::parse(dec.out);
+      EXPECT_EQ(j["sample_rate"], 5e6);
+      // The burst, and possibly a noise event that passed --min-rho: take the best rho.
+      ASSERT_GE(j["detections"].size(), 1u) << dec.out;
+      nlohmann::json det = j["detections"][0];
+      for (const auto& x : j["detections"]) {
+        if (x["rho"].get<double>() > det["rho"].get<double>()) det = x;
+      }
+      EXPECT_EQ(det["code"], code);
+      // The same receiver on the same samples: the ToF agrees to a fraction of a sample
+      // (the decoder's calibration uses the same transducers), rho to float rounding.
+      EXPECT_NEAR(det["tof_s"].get<double>(), tof, 0.05 / 5e6) << stem << ext;
+      EXPECT_NEAR(det["distance_m"].get<double>(), d, 1e-4);
+      EXPECT_NEAR(det["rho"].get<double>(), rho, 1e-5);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 8);
+  // 16-bit PCM of the same stream decodes too.
+  const Capture c = read_capture(dir + "/out/captures/M1_900mm_r1_j6.wav");
+  write(dir + "/pcm16.wav", capture_wav(c, WavFormat::Pcm16, 0.1));
+  const ToolRun p16 = run_tool("decode " + dir + "/pcm16.wav --family M1 --json");
+  ASSERT_EQ(p16.status, 0) << p16.err;
+  EXPECT_EQ(nlohmann::json::parse(p16.out)["detections"][0]["code"], 6);
+}
+
+TEST(DecodeCli, BadCapturesExitTwoWithAClearMessageAndNoOutput) {
+  const std::string dir = ::testing::TempDir() + "/capture_bad";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string ok = "TIME,CH1\n";
+  for (int n = 0; n < 3000; ++n) ok += sci(n * 2e-7) + "," + std::to_string(std::sin(n * 0.25)) + "\n";
+  Capture c;
+  c.sample_rate = 5e6;
+  c.samples.assign(5000, 0.1);
+  const std::string wav = capture_wav(c, WavFormat::Pcm16);
+  struct Case {
+    std::string name, content, args, expect;
+  };
+  const std::vector<Case> cases = {
+      {"empty.csv", "", "--family M1", "empty.csv:0: no data rows"},
+      {"cell.csv", "TIME,CH1\n0,0\n2e-7,x1\n", "--family M1", "cell.csv:3: voltage column: 'x1' is not a number"},
+      {"nan.csv", "TIME,CH1\n0,0\n2e-7,NaN\n", "--family M1", "nan.csv:3: voltage column: 'NaN' is not finite"},
+      {"inf.csv", "TIME,CH1\n0,0\n2e-7,-inf\n", "--family M1", "inf.csv:3:"},
+      {"back.csv", "TIME,CH1\n0,0\n2e-7,0\n1e-7,0\n", "--family M1", "back.csv:4: time does not increase"},
+      {"uneven.csv", "TIME,CH1\n0,0\n2e-7,0\n4e-7,0\n7e-7,0\n8e-7,0\n", "--family M1", "uneven.csv:5: uneven sampling"},
+      {"short.csv", "TIME,CH1\n0,0\n2e-7,0\n4e-7,0.1\n", "--family M1", "short.csv: too short"},
+      {"trunc.wav", wav.substr(0, 3000), "--family M1", "trunc.wav: byte 36: truncated"},
+      {"family.csv", ok, "--family M9", "option --family: unknown code family 'M9'"},
+      {"rate.csv", ok, "--family M1", ""},  // sanity: the good file decodes (exit 0)
+      {"ext.txt", ok, "--family M1", "unknown capture type"},
+  };
+  for (const auto& k : cases) {
+    write(dir + "/" + k.name, k.content);
+    const auto before = std::distance(fs::directory_iterator(dir), fs::directory_iterator{});
+    const ToolRun r = run_tool("decode " + dir + "/" + k.name + " " + k.args);
+    SCOPED_TRACE(k.name + ": " + r.err);
+    const auto after = std::distance(fs::directory_iterator(dir), fs::directory_iterator{});
+    EXPECT_EQ(before, after) << "no files left behind";
+    if (k.expect.empty()) {
+      EXPECT_EQ(r.status, 0);
+      continue;
+    }
+    EXPECT_EQ(r.status, 2);
+    EXPECT_TRUE(r.out.empty());
+    EXPECT_NE(r.err.find(k.expect), std::string::npos);
+  }
+  // A sample rate the receiver cannot use (4.9 MS/s: 24.5 samples per carrier cycle).
+  std::string odd = "TIME,CH1\n";
+  for (int n = 0; n < 3000; ++n) odd += sci(n / 4.9e6) + ",0.01\n";
+  write(dir + "/odd.csv", odd);
+  const ToolRun r = run_tool("decode " + dir + "/odd.csv --family M1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("integer >= 4"), std::string::npos) << r.err;
+}
