@@ -182,15 +182,19 @@ std::string gtkw(const std::vector<HwModuleParams>& mods, const std::string& ori
   auto bus = [](const std::string& name, std::int64_t w) {
     return "TOP.receiver_top." + name + "[" + std::to_string(w - 1) + ":0]\n";
   };
+  // An analog (step) trace, signed, four rows high.
+  auto analog = [&](const std::string& name, std::int64_t w) {
+    return "@8420\n" + bus(name, w) + "@20000\n-\n-\n-\n";
+  };
   std::ostringstream os;
   os << banner("#", origin) << "[*] open with: gtkwave <trace>.fst receiver.gtkw\n"
      << "[timestart] 0\n"
      << "@200\n-input samples\n@28\nTOP.receiver_top.s_axis_tvalid\nTOP.receiver_top.s_axis_tready\n"
-     << "@8420\n" << bus("s_axis_tdata", sos.value("IN_W"))
+     << analog("s_axis_tdata", sos.value("IN_W"))
      << "@200\n-bandpass filter\n@28\nTOP.receiver_top.dbg_filter_valid\n"
-     << "@8420\n" << bus("dbg_filter_data", sos.value("DATA_W"))
+     << analog("dbg_filter_data", sos.value("DATA_W"))
      << "@200\n-correlator bank\n@28\nTOP.receiver_top.dbg_bank_valid\n"
-     << "@8420\n" << bus("dbg_chip_re", bank.value("CHIP_W")) << bus("dbg_chip_im", bank.value("CHIP_W"))
+     << analog("dbg_chip_re", bank.value("CHIP_W")) << analog("dbg_chip_im", bank.value("CHIP_W"))
      << "@22\n" << bus("dbg_energy", bank.value("ENERGY_W")) << bus("dbg_index", bank.value("TIME_W"))
      << "@200\n-events\n@28\nTOP.receiver_top.m_axis_tvalid\nTOP.receiver_top.m_axis_tready\n"
      << "@22\n" << bus("event_code", det.value("CODE_W"))

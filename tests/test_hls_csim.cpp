@@ -1,8 +1,8 @@
 // C simulation of the HLS receiver (hls/receiver_hls.hpp) against the golden model
 // ReceiverFixed, bit for bit: every bandpass section output, every mixer output, every
 // decimated node (Bd, F, C, P, Q, E, index) and every event, on coded received signals, a
-// full-scale worst case and random noise. Also: the committed generated configuration
-// (hls/generated/default) is exactly what `ranging generate` writes for configs/default.yaml.
+// full-scale worst case and random noise. (tests/test_generate.cpp checks that the committed
+// generated/default is exactly what `ranging generate` writes for configs/default.yaml.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,7 +23,7 @@
 
 #include <unistd.h>
 
-#include "hls/generated/default/hls/receiver_config.hpp"
+#include "generated/default/hls/receiver_config.hpp"
 #include "hls/receiver_hls.hpp"
 #include "model/channel.hpp"
 #include "model/excitation.hpp"
@@ -37,33 +37,6 @@ using HlsReceiver = ranging_hls::Receiver<Cfg>;
 namespace {
 
 const std::string kSource = RANGING_SOURCE_DIR;
-const std::string kCommitted = kSource + "/hls/generated/default";
-
-std::map<std::string, std::string> read_tree(const fs::path& root) {
-  std::map<std::string, std::string> files;
-  for (const auto& e : fs::recursive_directory_iterator(root)) {
-    if (!e.is_regular_file()) continue;
-    std::ifstream in(e.path(), std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    files[fs::relative(e.path(), root).generic_string()] = ss.str();
-  }
-  return files;
-}
-
-// "line N: committed '...' / generated '...'" for the first differing line.
-std::string first_difference(const std::string& a, const std::string& b) {
-  std::istringstream sa(a), sb(b);
-  std::string la, lb;
-  for (int line = 1;; ++line) {
-    const bool ga = static_cast<bool>(std::getline(sa, la)), gb = static_cast<bool>(std::getline(sb, lb));
-    if (!ga && !gb) return "the end (line endings)";
-    if (ga != gb || la != lb) {
-      return "line " + std::to_string(line) + ": committed '" + (ga ? la : "<eof>") + "', generated '" +
-             (gb ? lb : "<eof>") + "'";
-    }
-  }
-}
 
 const ReceiverDesign& default_design() {
   static const ReceiverDesign d = design_receiver(load_receiver_config(kSource + "/configs/default.yaml"));
@@ -247,30 +220,6 @@ HlsReceiver& shared_hls() {
 }
 
 }  // namespace
-
-TEST(HlsGenerated, CommittedDefaultIsExactlyWhatTheGeneratorWrites) {
-  const fs::path tmp = fs::temp_directory_path() / ("ranging-hls-gen-" + std::to_string(::getpid()));
-  fs::remove_all(tmp);
-  const std::string cmd = std::string(RANGING_TOOL) + " generate --config " + kSource +
-                          "/configs/default.yaml --out " + tmp.string() +
-                          " --origin configs/default.yaml > /dev/null";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  const auto fresh = read_tree(tmp);
-  const auto committed = read_tree(kCommitted);
-  fs::remove_all(tmp);
-  ASSERT_FALSE(fresh.empty());
-  ASSERT_TRUE(fresh.count("hls/receiver_config.hpp"));
-  for (const auto& [name, text] : fresh) {
-    ASSERT_TRUE(committed.count(name)) << name << " is generated but not committed in hls/generated/default; regenerate";
-    EXPECT_TRUE(committed.at(name) == text)
-        << name << " differs from the generator's output at " << first_difference(committed.at(name), text)
-        << "; regenerate with `ranging generate --config configs/default.yaml --out hls/generated/default "
-           "--origin configs/default.yaml`";
-  }
-  for (const auto& [name, text] : committed) {
-    EXPECT_TRUE(fresh.count(name)) << name << " is committed but no longer generated";
-  }
-}
 
 // Every code at 100, 550 and 1000 mm, with and without noise: every node bit-exact, the
 // events decode the sent code, and the synthesis top emits the same event stream.
