@@ -464,7 +464,11 @@ class PeakDetector {
     const std::uint64_t norm1 = norm == 0 ? 1 : norm;
     const bool gate = best_q >= kThreshold * norm1 && norm >= kMinNorm;
     bool emit = false;
-    if (gate && (!cand_valid_ || best_q > cand_q_)) {
+    // The candidate is the best normalized match: Q / norm > Q_c / norm_c, cross-multiplied
+    // exactly (79 bits; ap_uint<128> under Vitis).
+    const unsigned __int128 lhs = static_cast<unsigned __int128>(best_q) * (cand_norm_ == 0 ? 1 : cand_norm_);
+    const unsigned __int128 rhs = static_cast<unsigned __int128>(cand_q_) * norm1;
+    if (gate && (!cand_valid_ || lhs > rhs)) {
       cand_valid_ = true;
       cand_has_next_ = false;
       cand_n_ = in.index;

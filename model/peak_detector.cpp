@@ -85,7 +85,7 @@ std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank)
   const std::int64_t n = bank.sample_index();
   const double rho2 = bank.rho2(best);
   const bool gate = rho2 >= cfg_.threshold && bank.energy() >= cfg_.min_energy;
-  if (gate && (!cand_ || q[best] > cand_->q)) {
+  if (gate && (!cand_ || rho2 > cand_->score)) {
     const double margin = rho2 - (bank.energy() > 0 ? second / bank.energy() : 0.0);
     cand_ = Candidate{n, best, prev_[best], q[best], 0.0, rho2, margin, false};
   } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
@@ -155,7 +155,10 @@ std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& 
   const bool gate = static_cast<uint128_t>(q[best]) >=
                         static_cast<uint128_t>(thr_q_) * std::max<std::uint64_t>(norm, 1) &&
                     norm >= min_norm_;
-  if (gate && (!cand_ || q[best] > cand_->q)) {
+  // rho^2 of the best code beats the candidate's: Q / norm > Q_c / norm_c, cross-multiplied.
+  const bool better = !cand_ || static_cast<uint128_t>(q[best]) * std::max<std::uint64_t>(cand_->norm, 1) >
+                                    static_cast<uint128_t>(cand_->q) * std::max<std::uint64_t>(norm, 1);
+  if (gate && better) {
     cand_ = Candidate{n, best, prev_[best], q[best], 0, second, norm, false};
   } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
     out = make_event(*cand_);

@@ -8,15 +8,21 @@
 //   best   = argmax_j Q_j  (lowest j on ties);  second = max_{j != best} Q_j
 //   gate   = rho^2_best >= threshold  and  E >= min_energy
 //   if the candidate was set at the previous output: record Q_code of its code as Q_next
-//   if gate and (no candidate or Q_best > Q_candidate): candidate := (n, best, Q_prev, Q, ...)
+//   if gate and (no candidate or rho^2_best > rho^2_candidate): candidate := (n, best, Q_prev, Q, ...)
 //   else if a candidate exists, its Q_next is known and n - n_candidate >= holdoff: emit it
 // The fraction is the vertex of the parabola through Q[k-1], Q[k], Q[k+1] of the winning code,
 //   delta = (Q_next - Q_prev) / (2 (2 Q - Q_prev - Q_next)),  clamped to [-1/2, 1/2],
 // in decimated samples; arrival = n + D delta full-rate samples.
+// The candidate is the best *normalized* match so far (rho^2 = Q / E), not the largest Q: the
+// next burst's correlation, already rising while this one waits out its holdoff (bursts every
+// T ~ 1.4 template spans overlap in the window), has more raw power in the mixed window but a
+// lower rho^2 than a clean peak, so it cannot take the candidate over; sidelobes before a
+// peak have a lower rho^2 than the peak, so the candidate still climbs to it.
 // Event latency: holdoff samples after the peak. Two bursts closer than holdoff merge into the
 // stronger one, so holdoff <= the transmit period (the paper's T >= 1.5 T_d).
 //
-// Fixed point: the gate is the exact integer test Q >= thr_q * max(norm, 1) (no divider per
+// Fixed point: the gate is the exact integer test Q >= thr_q * max(norm, 1) and the candidate
+// test the exact cross product Q * max(norm_cand, 1) > Q_cand * max(norm, 1) (no divider per
 // sample); score = min(2^score_bits - 1, floor(Q / max(norm, 1))) and margin = score(best) -
 // score(second) are computed only at an event. The fraction is (Q_next - Q_prev) 2^frac_bits /
 // (2 den) truncated toward zero (parabolic_fraction), then multiplied by D.

@@ -5,7 +5,8 @@
 //   best = argmax_j Q_j (lowest j on ties), second = max_{j != best} Q_j   (sequential scan)
 //   norm = E >> ENERGY_SHIFT;  gate = Q_best >= THRESHOLD * max(norm,1) && norm >= MIN_NORM
 //   a pending candidate whose right neighbour is unknown takes Q_next = Q_code(this beat)
-//   if gate && (no candidate || Q_best > Q_cand): candidate := {n, best, Q_prev, Q, second, norm}
+//   if gate && (no candidate || Q_best * max(norm_cand,1) > Q_cand * max(norm,1)):
+//       candidate := {n, best, Q_prev, Q, second, norm}   (the best rho^2 = Q / norm so far)
 //   else if candidate && Q_next known && n - n_cand >= HOLDOFF: emit it
 //   Q_prev := this beat's Q vector
 // An event, computed with one sequential restoring divider (3 divisions):
@@ -127,6 +128,11 @@ module peak_detector #(
   wire hn     = c_has_next || hn_now;
   wire [QW-1:0] qn = hn_now ? q_cand : c_qn;
   wire [TIME_W-1:0] since = n_r - c_n;
+  // rho^2 of the best code beats the candidate's: Q / norm > Q_c / norm_c, cross-multiplied.
+  wire [ENERGY_W-1:0] c_norm1 = (c_norm == {ENERGY_W{1'b0}}) ? {{(ENERGY_W-1){1'b0}}, 1'b1} : c_norm;
+  wire [QW+ENERGY_W-1:0] better_lhs = {{ENERGY_W{1'b0}}, best_q} * {{QW{1'b0}}, c_norm1};
+  wire [QW+ENERGY_W-1:0] better_rhs = {{ENERGY_W{1'b0}}, c_q} * {{QW{1'b0}}, norm1};
+  wire better = better_lhs > better_rhs;
 
   // Fraction operands of the candidate being emitted (computed in DECIDE from c_* and qn).
   wire signed [QW+2:0] den_s = ({3'b0, c_q} <<< 2) - ({3'b0, c_qp} <<< 1) - ({3'b0, qn} <<< 1);
@@ -192,7 +198,7 @@ module peak_detector #(
         S_DECIDE: begin
           prev <= q_r;
           state <= S_IDLE;
-          if (gate && (!c_valid || best_q > c_q)) begin
+          if (gate && (!c_valid || better)) begin
             c_valid <= 1'b1;
             c_has_next <= 1'b0;
             c_n <= n_r;
