@@ -188,7 +188,7 @@ std::string gtkw(const std::vector<HwModuleParams>& mods, const std::string& ori
   };
   std::ostringstream os;
   os << banner("#", origin) << "[*] open with: gtkwave <trace>.fst receiver.gtkw\n"
-     << "[timestart] 0\n"
+     << "[timestart] 0\n[size] 1600 1000\n[pos] 0 0\n[sst_width] 1\n[signals_width] 300\n"
      << "@200\n-input samples\n@28\nTOP.receiver_top.s_axis_tvalid\nTOP.receiver_top.s_axis_tready\n"
      << analog("s_axis_tdata", sos.value("IN_W"))
      << "@200\n-bandpass filter\n@28\nTOP.receiver_top.dbg_filter_valid\n"
