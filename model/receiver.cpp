@@ -1,7 +1,5 @@
 #include "model/receiver.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -13,6 +11,7 @@
 
 #include "model/error.hpp"
 #include "model/excitation.hpp"
+#include "model/yaml_reader.hpp"
 
 namespace ranging {
 
@@ -57,72 +56,14 @@ void validate(const ReceiverConfig& cfg) {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& origin, const YAML::Node& node, const std::string& key,
-                       const std::string& what) {
-  std::ostringstream os;
-  os << origin << ":" << node.Mark().line + 1 << ": " << key << ": " << what;
-  throw InputError(os.str());
-}
+using yaml::Reader;
+using yaml::section;
 
-// Reads a mapping strictly: every key must be consumed by one of the handlers.
-class MapReader {
- public:
-  MapReader(const YAML::Node& node, std::string origin, std::string path)
-      : node_(node), origin_(std::move(origin)), path_(std::move(path)) {
-    if (!node_.IsMap()) fail(origin_, node_, path_.empty() ? "(top)" : path_, "expected a mapping");
-  }
-  std::string key(const std::string& k) const { return path_.empty() ? k : path_ + "." + k; }
-
-  template <class T>
-  void get(const std::string& k, T& out) {
-    seen_.insert(k);
-    const YAML::Node v = node_[k];
-    if (!v) return;
-    if (!v.IsScalar()) fail(origin_, v, key(k), "expected a scalar");
-    try {
-      out = v.as<T>();
-    } catch (const YAML::Exception&) {
-      fail(origin_, v, key(k), "'" + v.Scalar() + "' has the wrong type");
-    }
-    if constexpr (std::is_floating_point_v<T>) {
-      if (!std::isfinite(out)) fail(origin_, v, key(k), "value is not finite");
-    }
-  }
-  // An integer, or "auto" (stored as -1).
-  void get_auto(const std::string& k, int& out) {
-    seen_.insert(k);
-    const YAML::Node v = node_[k];
-    if (!v) return;
-    if (v.IsScalar() && v.Scalar() == "auto") {
-      out = -1;
-      return;
-    }
-    get(k, out);
-  }
-  YAML::Node child(const std::string& k) {
-    seen_.insert(k);
-    return node_[k];
-  }
-  void finish() const {
-    for (const auto& kv : node_) {
-      const std::string k = kv.first.as<std::string>();
-      if (!seen_.count(k)) fail(origin_, kv.first, key(k), "unknown key");
-    }
-  }
-  const std::string& origin() const { return origin_; }
-
- private:
-  YAML::Node node_;
-  std::string origin_, path_;
-  std::set<std::string> seen_;
-};
-
-Rounding parse_rounding(const std::string& s, const std::string& origin, const YAML::Node& n,
-                        const std::string& key) {
+Rounding parse_rounding(Reader& r, const std::string& k, const std::string& s) {
   if (s == "truncate") return Rounding::Truncate;
   if (s == "round-half-up") return Rounding::RoundHalfUp;
   if (s == "convergent") return Rounding::Convergent;
-  fail(origin, n, key, "'" + s + "' is not valid; valid: truncate, round-half-up, convergent");
+  r.error(k, "'" + s + "' is not valid; valid: truncate, round-half-up, convergent");
 }
 std::string rounding_name(Rounding r) {
   switch (r) {
@@ -132,44 +73,29 @@ std::string rounding_name(Rounding r) {
   }
   return "?";
 }
-Overflow parse_overflow(const std::string& s, const std::string& origin, const YAML::Node& n,
-                        const std::string& key) {
+Overflow parse_overflow(Reader& r, const std::string& k, const std::string& s) {
   if (s == "wrap") return Overflow::Wrap;
   if (s == "saturate") return Overflow::Saturate;
-  fail(origin, n, key, "'" + s + "' is not valid; valid: wrap, saturate");
-}
-
-template <class F>
-void section(MapReader& top, const std::string& name, F&& body) {
-  YAML::Node n = top.child(name);
-  if (!n) return;
-  MapReader r(n, top.origin(), name);
-  body(r, n);
-  r.finish();
+  r.error(k, "'" + s + "' is not valid; valid: wrap, saturate");
 }
 
 }  // namespace
 
 ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::ParserException& e) {
-    throw InputError(origin + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = yaml::load(yaml_text, origin);
   ReceiverConfig cfg;
   if (!root || root.IsNull()) throw InputError(origin + ": the configuration is empty");
-  MapReader top(root, origin, "");
+  Reader top(root, origin, "");
   top.get("name", cfg.name);
   top.get("family", cfg.family);
   top.get("architecture", cfg.architecture);
-  section(top, "signal", [&](MapReader& r, const YAML::Node&) {
+  section(top, "signal", [&](Reader& r) {
     r.get("carrier_hz", cfg.carrier_hz);
     r.get("cycles_per_chip", cfg.cycles_per_chip);
     r.get("fs", cfg.fs);
   });
   std::string type = filter_type_name(cfg.filter_type);
-  section(top, "filter", [&](MapReader& r, const YAML::Node& n) {
+  section(top, "filter", [&](Reader& r) {
     r.get("type", type);
     r.get("order", cfg.filter_order);
     r.get("fp1", cfg.filter.fp1);
@@ -181,12 +107,11 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
     try {
       cfg.filter_type = parse_filter_type(type);
     } catch (const InputError&) {
-      fail(origin, n["type"] ? n["type"] : n, "filter.type",
-           "'" + type + "' is not valid; valid: butter, cheby1, ellip");
+      r.error("type", "'" + type + "' is not valid; valid: butter, cheby1, ellip");
     }
   });
   cfg.filter.fs = cfg.fs;
-  section(top, "bandpass_fixed", [&](MapReader& r, const YAML::Node& n) {
+  section(top, "bandpass_fixed", [&](Reader& r) {
     auto& b = cfg.bandpass;
     r.get("input_bits", b.input_bits);
     r.get("coef_bits", b.coef_bits);
@@ -197,17 +122,17 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
     std::string rnd = rounding_name(b.rounding), ovf = b.overflow == Overflow::Wrap ? "wrap" : "saturate";
     r.get("rounding", rnd);
     r.get("overflow", ovf);
-    b.rounding = parse_rounding(rnd, origin, n["rounding"] ? n["rounding"] : n, "bandpass_fixed.rounding");
-    b.overflow = parse_overflow(ovf, origin, n["overflow"] ? n["overflow"] : n, "bandpass_fixed.overflow");
+    b.rounding = parse_rounding(r, "rounding", rnd);
+    b.overflow = parse_overflow(r, "overflow", ovf);
   });
-  section(top, "correlator", [&](MapReader& r, const YAML::Node&) {
+  section(top, "correlator", [&](Reader& r) {
     r.get("reference", cfg.reference);
     r.get("transducer_centre_hz", cfg.reference_transducer.centre_hz);
     r.get("transducer_q", cfg.reference_transducer.q);
     r.get("decimation", cfg.decimation);
     r.get("template_floor", cfg.template_floor);
   });
-  section(top, "correlator_fixed", [&](MapReader& r, const YAML::Node&) {
+  section(top, "correlator_fixed", [&](Reader& r) {
     auto& c = cfg.correlator;
     r.get("lo_bits", c.lo_bits);
     r.get("mix_bits", c.mix_bits);
@@ -219,7 +144,7 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
     r.get_auto("energy_shift", c.energy_shift);
     r.get("score_bits", c.score_bits);
   });
-  section(top, "detector", [&](MapReader& r, const YAML::Node&) {
+  section(top, "detector", [&](Reader& r) {
     auto& d = cfg.detector;
     r.get("threshold", d.threshold);
     r.get_auto("holdoff", d.holdoff);
