@@ -1,6 +1,8 @@
 // Captures: CSV/WAV readers and writers, `ranging decode`, the simulate -> capture -> decode
 // round trip, and every bad-capture case (clear error naming file and line, exit 2, no output).
 #include <gtest/gtest.h>
+
+#include "tests/process.hpp"
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -18,24 +20,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct ToolRun {
-  int status;
-  std::string out, err;
-};
-ToolRun run_tool(const std::string& args) {
-  const std::string errfile = ::testing::TempDir() + "/capture_stderr.txt";
-  const std::string cmd = std::string(RANGING_TOOL) + " " + args + " 2>" + errfile;
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, pipe.get())) > 0) out.append(buf, n);
-  const int status = pclose(pipe.release());
-  std::ifstream e(errfile);
-  std::stringstream ss;
-  ss << e.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, ss.str()};
-}
+using ToolRun = testing_support::ProcessResult;
+using testing_support::run_tool;
 
 std::string sci(double v) {
   char b[40];
@@ -127,7 +113,7 @@ TEST(Capture, BadWavIsRefusedWithByteOffset) {
 
 // simulate --write-captures, then decode every capture back: same code, same distance.
 TEST(DecodeCli, DecodesSimulatedCapturesBackToTheSimulatedResults) {
-  const std::string dir = ::testing::TempDir() + "/capture_rt";
+  const std::string dir = ::testing::TempDir() + "/capture_rt_" + std::to_string(::getpid());
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string scene = dir + "/rt.yaml";
@@ -179,7 +165,7 @@ TEST(DecodeCli, DecodesSimulatedCapturesBackToTheSimulatedResults) {
 }
 
 TEST(DecodeCli, BadCapturesExitTwoWithAClearMessageAndNoOutput) {
-  const std::string dir = ::testing::TempDir() + "/capture_bad";
+  const std::string dir = ::testing::TempDir() + "/capture_bad_" + std::to_string(::getpid());
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::string ok = "TIME,CH1\n";

@@ -51,7 +51,7 @@ TEST(Evaluate, ReducedPaperSceneReproducesTable6AndTable5AndWritesTheDocument) {
   replace_line("  distances_m: [", "  distances_m: [0.1, 1.0]");
   replace_line("  repeats: ", "  repeats: 2");
   replace_line("name: ", "name: reduced");
-  const std::string dir = ::testing::TempDir() + "/evaluate_reduced";
+  const std::string dir = ::testing::TempDir() + "/evaluate_reduced_" + std::to_string(::getpid());
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir + "/reduced.yaml") << scene;

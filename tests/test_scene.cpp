@@ -186,7 +186,7 @@ TEST(Medium, SpeedOfSoundAndAbsorptionMatchPublishedValues) {
 }
 
 TEST(SimulateCli, WritesCsvAndSummaryAndPrintsStages) {
-  const std::string dir = ::testing::TempDir() + "/sim_cli";
+  const std::string dir = ::testing::TempDir() + "/sim_cli_" + std::to_string(::getpid());
   std::filesystem::remove_all(dir);
   const ToolRun r = run_tool("simulate " + std::string(RANGING_SOURCE_DIR) + "/scenes/minimal.yaml --out " + dir +
                              " --quiet");
