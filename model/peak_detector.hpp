@@ -35,7 +35,7 @@
 namespace ranging {
 
 struct DetectorConfig {
-  double threshold = 0.25;   // on rho^2 (0..1)
+  double threshold = 0.5;    // on rho^2 (0..1): noise alone reaches ~0.35 (docs/scenes.md)
   int holdoff = -1;          // full-rate samples; -1: the energy window (the template span)
   double min_energy = 1e-4;  // on E = sum of y^2 over the window, in full-scale units^2
   int frac_bits = 8;         // sub-sample fraction bits of the arrival time (fixed point)

@@ -60,7 +60,7 @@ struct ReceiverConfig {
   static constexpr std::int64_t DET_DECIM = 5;
   static constexpr std::int64_t DET_TIME_W = 40;
   static constexpr std::int64_t DET_HOLDOFF = 1005;
-  static constexpr std::int64_t DET_THRESHOLD[1] = {16384};
+  static constexpr std::int64_t DET_THRESHOLD[1] = {32768};
   static constexpr std::int64_t DET_MIN_NORM[1] = {27};
   static constexpr std::int64_t DET_CODE_W = 4;
 };

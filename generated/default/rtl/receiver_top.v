@@ -110,7 +110,7 @@ module receiver_top (
     .DECIM(5),
     .TIME_W(40),
     .HOLDOFF(1005),
-    .THRESHOLD(16'h4000),
+    .THRESHOLD(16'h8000),
     .MIN_NORM(41'h0000000001b),
     .CODE_W(4)
   ) u_detector (
