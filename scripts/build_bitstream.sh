@@ -14,6 +14,7 @@ out=""
 results="$root/docs/results"
 check=0
 others=1
+breakdown=0
 margin=1.10
 
 usage() {
@@ -34,6 +35,7 @@ Options:
                     (default: BUILD/bitstream)
   --results DIR     where the summary goes (default: docs/results)
   --no-others       skip the ECP5 and Xilinx estimates
+  --breakdown       also synthesize without flattening and list the iCE40 resources per module
   --check           exit 1 unless the design meets the targets: <= 5280 LUT4, <= 8 SB_MAC16,
                     <= 30 EBR, <= 4 SPRAM, placed and routed, Fmax >= 1.1 x the system clock
   -h, --help        this text
@@ -51,6 +53,7 @@ while [[ $# -gt 0 ]]; do
     --out) out=$(realpath -m "${2:?--out needs a DIR}"); shift 2 ;;
     --results) results=$(realpath -m "${2:?--results needs a DIR}"); shift 2 ;;
     --no-others) others=0; shift ;;
+    --breakdown) breakdown=1; shift ;;
     --check) check=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) usage >&2; die "unknown option '$1'" ;;
@@ -131,6 +134,17 @@ if [[ $pnr_ok == 1 ]]; then
   icetime -d up5k -P sg48 -p "$pcf" -c "$clk_mhz" -t "$out/ice40_top.asc" >"$out/icetime.log" 2>&1 || true
 else
   log "nextpnr failed (the design does not fit or route): see $out/nextpnr.log"
+fi
+
+# --- per-module iCE40 resources (no flattening: slightly above the flattened totals) -----------
+rm -f "$out/stat_modules.txt"
+if [[ $breakdown == 1 ]]; then
+  log "yosys synth_ice40 -dsp -noflatten (per-module resources)"
+  rc=""
+  for f in "${sources[@]}"; do rc+="read_verilog -defer $f; "; done
+  nice yosys -q -l "$out/yosys_modules.log" -p "$rc hierarchy -top ranging_system_top; \
+      synth_ice40 -dsp -noflatten -top ranging_system_top; tee -q -o $out/stat_modules.txt stat" >/dev/null ||
+    die "yosys (per-module) failed: see $out/yosys_modules.log"
 fi
 
 # --- ECP5 and Xilinx estimates -----------------------------------------------------------------
@@ -246,6 +260,23 @@ def fam_summary(fam, counts):
             "ramb18": counts.get("RAMB18E1", 0), "ramb36": counts.get("RAMB36E1", 0),
             "lutram": sum(v for k, v in counts.items() if k.startswith("RAM") and "B" not in k[:4])}
 
+modules = {}
+mp = os.path.join(out, "stat_modules.txt")
+if os.path.exists(mp):
+    for block in re.split(r"^=== ", open(mp).read(), flags=re.M)[1:]:
+        parts = block.split(" ===", 1)[0].strip().split("\\")
+        name = next((x for x in parts if x and not x.startswith("$") and "=" not in x), parts[-1])
+        if name == "design hierarchy":
+            continue
+        c = {}
+        for m in re.finditer(r"^\s+(\S+)\s+(\d+)\s*$", block, re.M):
+            c[m.group(1)] = c.get(m.group(1), 0) + int(m.group(2))
+        modules[name] = {"lut4": c.get("SB_LUT4", 0),
+                         "dff": sum(v for k, v in c.items() if k.startswith("SB_DFF")),
+                         "sb_mac16": c.get("SB_MAC16", 0), "ebr": c.get("SB_RAM40_4K", 0)}
+if modules:
+    summary["ice40_modules"] = modules
+
 others = {}
 for tag in ("default", "large"):
     for fam in ("ecp5", "xilinx"):
@@ -298,6 +329,13 @@ md = [f"# Bitstream summary ({cfg})", "",
       f"| margin | {v(ic.get('margin_percent'))} % |",
       f"| icetime critical path | {v(ic.get('icetime_path_ns'))} ns ({v(ic.get('icetime_fmax_mhz'))} MHz) |",
       f"| bitstream | {v(ic['bitstream'])} |", ""]
+if modules:
+    md += ["## iCE40 resources per module (synth_ice40 -dsp -noflatten)", "",
+           "| module | LUT4 | DFF | SB_MAC16 | EBR |", "|---|---|---|---|---|"]
+    for name, r in sorted(modules.items(), key=lambda kv: -kv[1]["lut4"]):
+        if r["lut4"] or r["dff"] or r["sb_mac16"] or r["ebr"]:
+            md.append(f"| {name} | {r['lut4']} | {r['dff']} | {r['sb_mac16']} | {r['ebr']} |")
+    md.append("")
 if others:
     md += ["## Other families (yosys estimates of ranging_system_top, no place and route)", "",
            "| configuration | family | LUT | FF | DSP | block RAM |", "|---|---|---|---|---|---|"]

@@ -39,12 +39,14 @@ if(EXISTS ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v AND EXISTS ${RANGING_SYSTEM_
   target_compile_definitions(tb_ranging_system PRIVATE RANGING_TB_CLK_DIV=${RANGING_TB_CLK_DIV_VALUE})
 endif()
 
-# Post-synthesis equivalence: the synthesized receiver netlist against the golden model (Icarus).
+# Post-synthesis equivalence: the synthesized receiver netlist against the golden model
+# (gate-level simulation with Verilator and yosys' ice40 cells_sim.v).
 find_program(RANGING_YOSYS_BIN yosys)
-find_program(RANGING_PS_IVERILOG iverilog)
-find_program(RANGING_PS_VVP vvp)
-if(RANGING_YOSYS_BIN AND RANGING_PS_IVERILOG AND EXISTS ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v)
-  execute_process(COMMAND yosys-config --datdir OUTPUT_VARIABLE RANGING_YOSYS_DATDIR OUTPUT_STRIP_TRAILING_WHITESPACE)
+find_program(RANGING_PS_VERILATOR verilator)
+if(RANGING_YOSYS_BIN AND RANGING_PS_VERILATOR AND EXISTS ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v)
+  get_filename_component(RANGING_YOSYS_PREFIX ${RANGING_YOSYS_BIN} DIRECTORY)
+  find_path(RANGING_YOSYS_DATDIR ice40/cells_sim.v HINTS ${RANGING_YOSYS_PREFIX}/../share/yosys
+            /usr/share/yosys /usr/local/share/yosys REQUIRED)
   add_executable(tb_postsynth ${CMAKE_CURRENT_SOURCE_DIR}/tb_postsynth.cpp)
   set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/tb_postsynth.cpp PROPERTIES
     COMPILE_OPTIONS "$<$<BOOL:${RANGING_WERROR}>:-Werror>")
@@ -56,8 +58,7 @@ if(RANGING_YOSYS_BIN AND RANGING_PS_IVERILOG AND EXISTS ${PROJECT_SOURCE_DIR}/rt
     RANGING_CONFIG="${PROJECT_SOURCE_DIR}/configs/default.yaml"
     RANGING_YOSYS_BIN="${RANGING_YOSYS_BIN}"
     RANGING_YOSYS_DATDIR="${RANGING_YOSYS_DATDIR}"
-    RANGING_IVERILOG_BIN="${RANGING_PS_IVERILOG}"
-    RANGING_VVP_BIN="${RANGING_PS_VVP}"
+    RANGING_VERILATOR_BIN="${RANGING_PS_VERILATOR}"
     RANGING_POSTSYNTH_WORK_DIR="${CMAKE_CURRENT_BINARY_DIR}/postsynth")
   add_test(NAME postsynth_equivalence COMMAND tb_postsynth)
   set_tests_properties(postsynth_equivalence PROPERTIES LABELS "bitstream" TIMEOUT 3600)
@@ -67,11 +68,11 @@ endif()
 # docs/results/bitstream.{json,md}; the ctest entry (label "bitstream") builds it into the
 # build tree and fails unless the targets of docs/bitstream.md are met.
 add_custom_target(bitstream
-  COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR}
+  COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR} --breakdown
   DEPENDS ranging ranging_system_gen
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
   USES_TERMINAL)
 add_test(NAME bitstream_targets
-  COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR}
+  COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR} --breakdown
           --out ${CMAKE_BINARY_DIR}/bitstream-test --results ${CMAKE_BINARY_DIR}/bitstream-test/results --check)
 set_tests_properties(bitstream_targets PROPERTIES LABELS "bitstream" TIMEOUT 7200)
