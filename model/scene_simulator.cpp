@@ -238,13 +238,15 @@ struct SceneSimulator::Link {
         ExcitationParams ex{s.excitation.carrier_hz, design.config.cycles_per_chip, s.fs, 1.0};
         templates[j] = bpsk_excitation(design.family.codes[j], ex);
         templates[j].resize(template_len, 0.0);
-      } else {
-        templates[j] = load_reference(static_cast<int>(j) + 1);
       }
+    }
+    // Recorded references are aligned by the receiver's calibrated arrival, so every offset first.
+    if (s.receiver.reference == "files") {
+      for (std::size_t j = 0; j < eta; ++j) templates[j] = load_reference(static_cast<int>(j) + 1);
     }
   }
 
-  std::vector<double> load_reference(int j) const {
+  std::vector<double> load_reference(int j) {
     const Scene& s = *scene;
     namespace fs = std::filesystem;
     const std::string stem = s.receiver.references_dir + "/" + family_name + "-" + std::to_string(j);
@@ -261,10 +263,32 @@ struct SceneSimulator::Link {
       throw InputError(path + ": reference sampled at " + fmt(c.sample_rate, 9) + " Hz, the signal at " +
                        fmt(s.fs, 9) + " Hz");
     }
-    // The reference starts where its T_d window starts (the paper's recordings are cut so).
-    const Duration td = duration_td(c.samples, c.sample_rate);
-    std::vector<double> t(c.samples.begin() + static_cast<long>(td.first), c.samples.end());
-    t.resize(template_len, 0.0);
+    const std::size_t burst = static_cast<std::size_t>(L * spc);
+    if (c.samples.size() < burst) {
+      throw InputError(path + ": too short: " + std::to_string(c.samples.size()) + " samples, a " + family_name +
+                       " burst is " + std::to_string(burst));
+    }
+    // A recording has its own time origin: the receiver finds the burst in it, and the template
+    // (filtered like the received signal: the paper's references are filtered signals) starts at
+    // its calibrated arrival, as the segments it is compared with do (metrics()).
+    std::vector<double> x = c.samples;
+    double peak = 0;
+    for (double v : x) peak = std::max(peak, std::abs(v));
+    if (peak == 0.0) throw InputError(path + ": reference is all zero");
+    x.resize(x.size() + stream_tail(), 0.0);
+    std::vector<double> y;
+    const Event* best = nullptr;
+    const auto ev = receive(x, peak / 0.5, y);
+    for (const auto& e : ev) {
+      if (!best || e.score > best->score) best = &e;
+    }
+    if (!best) throw InputError(path + ": the receiver detects no " + family_name + " burst in this reference");
+    const long k0 = std::lround(best->arrival - offset[static_cast<std::size_t>(best->code - 1)]);
+    std::vector<double> t(template_len, 0.0);
+    for (std::size_t i = 0; i < template_len; ++i) {
+      const long k = k0 + static_cast<long>(i);
+      if (k >= 0 && k < static_cast<long>(c.samples.size())) t[i] = y[static_cast<std::size_t>(k)];
+    }
     return t;
   }
 
