@@ -9,6 +9,7 @@
 
 #include "model/error.hpp"
 #include "model/hw_params.hpp"
+#include "model/hw_system.hpp"
 
 namespace ranging {
 namespace {
@@ -214,6 +215,7 @@ std::map<std::string, std::string> generate_hardware_files(const ReceiverDesign&
   files["receiver.gtkw"] = gtkw(mods, origin);
   files["hls/receiver_config.hpp"] = hls_config(mods, origin);
   files["manifest.json"] = manifest(design, mods, origin);
+  for (const auto& [name, text] : generate_system_files(design, origin)) files[name] = text;
   return files;
 }
 

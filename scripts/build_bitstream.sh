@@ -69,7 +69,6 @@ py=/usr/bin/python3
 [[ -x "$py" ]] || die "/usr/bin/python3 not found"
 ranging="$build/tool/ranging"
 [[ -x "$ranging" ]] || die "$ranging not found: build it first (cmake --build $build --target ranging)"
-sysgen="$build/tb/ranging_system_gen"
 
 receiver_rtl=("$root/rtl/bandpass_sos.v" "$root/rtl/correlator_bank.v" "$root/rtl/peak_detector.v")
 system_rtl=("$root/rtl/adc_interface.v" "$root/rtl/tx_scheduler.v" "$root/rtl/tof_distance.v"
@@ -89,14 +88,6 @@ generate() {
   origin=$(realpath --relative-to="$root" "$cfg")
   "$ranging" generate --config "$cfg" --out "$dir" --origin "$origin" >"$dir.log" 2>&1 ||
     { cat "$dir.log" >&2; die "ranging generate failed for $cfg"; }
-  if [[ ! -f "$dir/rtl/ranging_system_top.v" ]]; then
-    # `ranging generate` does not emit the system files yet: the stand-alone generator does.
-    [[ -x "$sysgen" ]] || die "$sysgen not found (cmake --build $build --target ranging_system_gen)"
-    "$sysgen" "$cfg" "$dir-system" "$origin" >>"$dir.log" 2>&1 ||
-      { cat "$dir.log" >&2; die "system generation failed for $cfg"; }
-    cp "$dir-system/rtl/ranging_system_top.v" "$dir/rtl/"
-    cp "$dir-system/system.json" "$dir/"
-  fi
 }
 
 log "generating $(realpath --relative-to="$root" "$config")"

@@ -6,8 +6,15 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install-deps.sh" --hardware
 jobs=$(nproc)
+# Labels: unit, hardware, postsynth run always; bitstream (place and route against the UP5K
+# targets, ~10 min) only with RANGING_BITSTREAM=1; soak only with RANGING_SOAK=1.
+skip=()
+[[ "${RANGING_SOAK:-0}" == "1" ]] || skip+=(soak)
+[[ "${RANGING_BITSTREAM:-0}" == "1" ]] || skip+=(bitstream)
 exclude=()
-[[ "${RANGING_SOAK:-0}" == "1" ]] || exclude=(-LE soak)
+if ((${#skip[@]})); then
+  exclude=(-LE "^($(IFS='|'; echo "${skip[*]}"))\$")
+fi
 
 echo "== build (Release) =="
 "$root/scripts/build.sh" "$root/build"

@@ -3,17 +3,8 @@
 
 set(RANGING_TB_CLK_DIV_VALUE 24)  # clocks per sample in the closed-loop testbench
 
-# Until `ranging generate` writes the system files itself, a small generator does.
-add_executable(ranging_system_gen ${CMAKE_CURRENT_SOURCE_DIR}/gen_system.cpp)
-target_link_libraries(ranging_system_gen PRIVATE ranging_model)
-target_include_directories(ranging_system_gen PRIVATE ${PROJECT_SOURCE_DIR})
-# The generated system files of the default configuration: in generated/default once
-# `ranging generate` writes them, committed in generated/default-system/ until then
-# (tests/test_hw_system.cpp regenerates them and fails on any difference).
-set(RANGING_GEN_SYSTEM ${PROJECT_SOURCE_DIR}/generated/default-system)
-if(EXISTS ${RANGING_GEN_DEFAULT}/rtl/ranging_system.vc)
-  set(RANGING_GEN_SYSTEM ${RANGING_GEN_DEFAULT})
-endif()
+# The generated system files of the default configuration are in generated/default (committed).
+set(RANGING_GEN_SYSTEM ${RANGING_GEN_DEFAULT})
 set(RANGING_SYSTEM_TB_VC ${CMAKE_CURRENT_BINARY_DIR}/ranging_system_tb.vc)
 if(EXISTS ${RANGING_GEN_SYSTEM}/rtl/ranging_system.vc)
   # The testbench's clock divider: the receiver RTL as it is must keep up (tb_ranging_system.cpp).
@@ -61,7 +52,7 @@ if(RANGING_YOSYS_BIN AND RANGING_PS_VERILATOR AND EXISTS ${PROJECT_SOURCE_DIR}/r
     RANGING_VERILATOR_BIN="${RANGING_PS_VERILATOR}"
     RANGING_POSTSYNTH_WORK_DIR="${CMAKE_CURRENT_BINARY_DIR}/postsynth")
   add_test(NAME postsynth_equivalence COMMAND tb_postsynth)
-  set_tests_properties(postsynth_equivalence PROPERTIES LABELS "bitstream" TIMEOUT 3600)
+  set_tests_properties(postsynth_equivalence PROPERTIES LABELS "postsynth" TIMEOUT 3600)
 endif()
 
 # The bitstream of the default configuration: `cmake --build BUILD --target bitstream` writes
@@ -69,7 +60,7 @@ endif()
 # build tree and fails unless the targets of docs/bitstream.md are met.
 add_custom_target(bitstream
   COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR} --breakdown
-  DEPENDS ranging ranging_system_gen
+  DEPENDS ranging
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
   USES_TERMINAL)
 add_test(NAME bitstream_targets
