@@ -75,7 +75,11 @@ std::string manifest(const ReceiverDesign& d, const std::vector<HwModuleParams>&
 std::string instance_params(const HwModuleParams& m) {
   std::ostringstream os;
   for (std::size_t i = 0; i < m.params.size(); ++i) {
-    os << "    ." << m.params[i].name << "(" << m.params[i].verilog << ")"
+    // Scalars as sized 32-bit literals: Verilator's -Wall refuses an unsized parameter value
+    // in a concatenation inside the module (WIDTHCONCAT).
+    const HwParam& p = m.params[i];
+    const std::string value = p.element_bits == 0 ? "32'd" + p.verilog : p.verilog;
+    os << "    ." << p.name << "(" << value << ")"
        << (i + 1 < m.params.size() ? ",\n" : "\n");
   }
   return os.str();

@@ -9,7 +9,7 @@ set(RANGING_SYSTEM_TB_VC ${CMAKE_CURRENT_BINARY_DIR}/ranging_system_tb.vc)
 if(EXISTS ${RANGING_GEN_SYSTEM}/rtl/ranging_system.vc)
   # The testbench's clock divider: the receiver RTL as it is must keep up (tb_ranging_system.cpp).
   file(READ ${RANGING_GEN_SYSTEM}/rtl/ranging_system.vc RANGING_SYSTEM_VC_TEXT)
-  string(REGEX REPLACE "-GCLK_DIV=[0-9]+" "-GCLK_DIV=${RANGING_TB_CLK_DIV_VALUE}" RANGING_SYSTEM_VC_TEXT
+  string(REGEX REPLACE "-GCLK_DIV=[^\n]+" "-GCLK_DIV=${RANGING_TB_CLK_DIV_VALUE}" RANGING_SYSTEM_VC_TEXT
          "${RANGING_SYSTEM_VC_TEXT}")
   file(WRITE ${RANGING_SYSTEM_TB_VC} "${RANGING_SYSTEM_VC_TEXT}")
 endif()

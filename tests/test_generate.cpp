@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "model/demo.hpp"
 #include "model/error.hpp"
 #include "tests/process.hpp"
 #include "model/hw_generator.hpp"
@@ -118,13 +119,16 @@ TEST(Generate, AFailedRunLeavesAPreviousOutputUntouched) {
   fs::remove(cfg);
 }
 
-// The committed generated/default/ is exactly what the generator writes for configs/default.yaml:
+// The committed generated/<config>/ is exactly what the generator writes for configs/<config>.yaml:
 // generated files are never edited by hand.
-TEST(Generate, CommittedDefaultIsUpToDate) {
-  const fs::path out = temp_dir("committed");
-  const fs::path committed = fs::path(RANGING_SOURCE_DIR) / "generated/default";
-  const ToolRun r = run_tool("generate --config " + std::string(RANGING_SOURCE_DIR) +
-                             "/configs/default.yaml --out " + out.string() + " --origin configs/default.yaml");
+class CommittedGenerated : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(CommittedGenerated, IsUpToDate) {
+  const std::string name = GetParam();
+  const fs::path out = temp_dir("committed_" + name);
+  const fs::path committed = fs::path(RANGING_SOURCE_DIR) / "generated" / name;
+  const ToolRun r = run_tool("generate --config " + std::string(RANGING_SOURCE_DIR) + "/configs/" + name +
+                             ".yaml --out " + out.string() + " --origin configs/" + name + ".yaml");
   ASSERT_EQ(r.status, 0) << r.err;
   auto files = [](const fs::path& root) {
     std::map<std::string, std::string> m;
@@ -138,13 +142,33 @@ TEST(Generate, CommittedDefaultIsUpToDate) {
     return m;
   };
   const auto fresh = files(out), old = files(committed);
-  for (const auto& [name, text] : fresh) {
-    ASSERT_TRUE(old.count(name)) << "generated/default/" << name << " is missing: regenerate";
-    EXPECT_EQ(old.at(name), text) << "generated/default/" << name
+  const std::string where = "generated/" + name + "/";
+  for (const auto& [file, text] : fresh) {
+    ASSERT_TRUE(old.count(file)) << where << file << " is missing: regenerate";
+    EXPECT_EQ(old.at(file), text) << where << file
                                   << " differs from the generator's output: regenerate, never edit by hand";
   }
-  for (const auto& [name, text] : old) {
-    EXPECT_TRUE(fresh.count(name)) << "generated/default/" << name << " is not generated any more";
+  for (const auto& [file, text] : old) {
+    EXPECT_TRUE(fresh.count(file)) << where << file << " is not generated any more";
   }
   fs::remove_all(out);
+}
+
+INSTANTIATE_TEST_SUITE_P(Configs, CommittedGenerated, ::testing::Values("default", "large"));
+
+// The large configuration (full rate, long received template) decodes every code too.
+TEST(Generate, LargeConfigurationDecodes) {
+  DemoParams p;
+  p.receiver = load_receiver_config(std::string(RANGING_SOURCE_DIR) + "/configs/large.yaml");
+  p.distances_m = {0.2, 0.9};
+  const auto rows = run_demo(p);
+  ASSERT_EQ(rows.size(), 18u);
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.fix.decoded, r.code);
+    EXPECT_EQ(r.flt.decoded, r.code);
+    EXPECT_LT(std::abs(r.fix.error_m), 1e-3);
+  }
+  const auto mods = hardware_parameters(design_receiver(p.receiver));
+  EXPECT_EQ(mods[1].value("DECIM"), 1);
+  EXPECT_GT(mods[1].value("TAPS"), 400);
 }
