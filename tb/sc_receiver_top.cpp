@@ -148,8 +148,10 @@ SC_MODULE(DutAdapter) {
 };
 
 SC_MODULE(Checker) {
+  sc_in<bool> clk;
   sc_fifo_in<EventFixed> dut, model;
-  std::size_t expected = 0, compared = 0, mismatches = 0;
+  const DutAdapter* adapter = nullptr;
+  std::size_t expected = 0, samples = 0, compared = 0, mismatches = 0, extra = 0;
   void run() {
     while (compared < expected) {
       const EventFixed a = dut.read();
@@ -160,6 +162,10 @@ SC_MODULE(Checker) {
       }
       ++compared;
     }
+    // Every sample must go through, and no further event may come out of the drained RTL.
+    while (adapter->accepted < samples) wait(clk.posedge_event());
+    for (int i = 0; i < 20000; ++i) wait(clk.posedge_event());
+    extra = static_cast<std::size_t>(dut.num_available());
     sc_stop();
   }
   SC_CTOR(Checker) { SC_THREAD(run); }
@@ -229,14 +235,18 @@ int sc_main(int, char**) {
   adapter.m_tready(m_tready);
   adapter.m_tdata(m_tdata);
   Checker checker("checker");
+  checker.clk(clk);
+  checker.adapter = &adapter;
+  checker.samples = samples.size();
   checker.expected = expected;
   checker.dut(ev_dut);
   checker.model(ev_model);
 
   sc_start(static_cast<double>(samples.size()) * 10 * 40, SC_NS);  // generous: stops at sc_stop
-  std::cout << "systemc: " << adapter.accepted << " samples through the RTL, " << checker.compared << "/"
-            << expected << " events compared, " << checker.mismatches << " mismatches\n";
+  std::cout << "systemc: " << adapter.accepted << "/" << samples.size() << " samples through the RTL, "
+            << checker.compared << "/" << expected << " events compared, " << checker.mismatches
+            << " mismatches, " << checker.extra << " extra events\n";
   const bool ok = expected > 0 && checker.compared == expected && checker.mismatches == 0 &&
-                  adapter.accepted == samples.size();
+                  checker.extra == 0 && adapter.accepted == samples.size();
   return ok ? 0 : 1;
 }
