@@ -1,8 +1,9 @@
 // The second simulator: Icarus Verilog (iverilog -g2012) runs the generated receiver_top for
 // every family of the paper's 7-bit codes (M1, M2, Gold1-7: each its own generated top, since
 // the code bits and weights are parameters), on vector files written by the golden model.
-// Every code of the family is sent (one burst per period, several in flight) and every event
-// must equal ReceiverFixed's; no output may be X after reset. This also proves the RTL uses no
+// Every code of the family is sent (one burst per period, several in flight); every decimated
+// correlator output (chip filter F, weighted power Q of every code, energy, index) and every
+// event must equal ReceiverFixed's; no output may be X after reset. This also proves the RTL uses no
 // Verilator-only construct.
 #include <gtest/gtest.h>
 
@@ -32,6 +33,10 @@ std::string bench(const ReceiverDesign& d, std::size_t n_samples) {
   const int arrival_w = static_cast<int>(mods[1].value("TIME_W") + mods[2].value("FRAC_W") + 1);
   const int score_w = static_cast<int>(mods[2].value("SCORE_W"));
   const int ev_w = code_w + arrival_w + 2 * score_w;
+  const auto& bank = mods[1];
+  const int codes = static_cast<int>(bank.value("CODES")), qw = static_cast<int>(bank.value("WEIGHTED_W"));
+  const int ew = static_cast<int>(bank.value("ENERGY_W")), tw = static_cast<int>(bank.value("TIME_W"));
+  const int fw = static_cast<int>(bank.value("CHIP_W"));
   std::ostringstream os;
   os << "`timescale 1ns/1ps\n"
         "module iv_top;\n"
@@ -40,12 +45,19 @@ std::string bench(const ReceiverDesign& d, std::size_t n_samples) {
         "  reg tvalid = 0, m_tready = 1;\n"
         "  wire tready, m_tvalid;\n"
         "  wire [" << ev_w - 1 << ":0] m_tdata;\n"
+        "  wire bank_valid;\n"
+        "  wire [" << codes * qw - 1 << ":0] weighted;\n"
+        "  wire [" << ew - 1 << ":0] energy;\n"
+        "  wire [" << tw - 1 << ":0] index;\n"
+        "  wire signed [" << fw - 1 << ":0] chip_re, chip_im;\n"
+        "  integer k;\n"
         "  reg [" << in_w - 1 << ":0] mem [0:" << n_samples - 1 << "];\n"
         "  integer i = 0, f, xs = 0, cycles = 0;\n"
         "  receiver_top dut(.clk(clk), .rst(rst), .s_axis_tdata(tdata), .s_axis_tvalid(tvalid),\n"
         "    .s_axis_tready(tready), .m_axis_tdata(m_tdata), .m_axis_tvalid(m_tvalid), .m_axis_tready(m_tready),\n"
-        "    .dbg_filter_valid(), .dbg_filter_data(), .dbg_filter_sections(), .dbg_bank_valid(),\n"
-        "    .dbg_weighted(), .dbg_energy(), .dbg_index(), .dbg_chip_re(), .dbg_chip_im(),\n"
+        "    .dbg_filter_valid(), .dbg_filter_data(), .dbg_filter_sections(), .dbg_bank_valid(bank_valid),\n"
+        "    .dbg_weighted(weighted), .dbg_energy(energy), .dbg_index(index), .dbg_chip_re(chip_re),\n"
+        "    .dbg_chip_im(chip_im),\n"
         "    .dbg_corr_re(), .dbg_corr_im());\n"
         "  always #5 clk = ~clk;\n"
         "  initial begin\n"
@@ -58,6 +70,12 @@ std::string bench(const ReceiverDesign& d, std::size_t n_samples) {
         "    cycles <= cycles + 1;\n"
         "    m_tready <= ($random & 3) != 0;\n"
         "    if ((^{tready, m_tvalid}) === 1'bx) xs = xs + 1;\n"
+        "    // Every decimated correlator output: index, energy, F, Q of every code.\n"
+        "    if (bank_valid) begin\n"
+        "      $fwrite(f, \"B %0d %0d %0d %0d\", index, energy, chip_re, chip_im);\n"
+        "      for (k = 0; k < " << codes << "; k = k + 1) $fwrite(f, \" %0d\", weighted[k*" << qw << " +: " << qw << "]);\n"
+        "      $fwrite(f, \"\\n\");\n"
+        "    end\n"
         "    if (m_tvalid && m_tready) begin\n"
         "      if ((^m_tdata) === 1'bx) xs = xs + 1;\n"
         "      $fwrite(f, \"%0d %0d %0d %0d\\n\", m_tdata[" << code_w - 1 << ":0], $signed(m_tdata["
@@ -118,10 +136,18 @@ TEST_P(ReceiverFamiliesIcarus, EveryCodeDecodesIdenticallyToTheModel) {
   const double distance = 0.1 + 0.05 * (std::string(GetParam()).back() % 9);  // 0.1 .. 0.5 m
   const auto x = stimulus(d, distance, 1234);
   std::vector<EventFixed> expected;
+  std::vector<std::string> expected_bank;  // "index energy F_re F_im Q_1 .. Q_eta" per decimated output
   {
     ReceiverFixed rx(d);
     for (auto v : x) {
       if (auto e = rx.execute_raw(v)) expected.push_back(*e);
+      const auto& b = rx.bank();
+      if ((b.sample_index() + 1) % b.layout().decimation == 0) {
+        std::ostringstream os;
+        os << b.sample_index() << " " << b.energy() << " " << b.chip_re() << " " << b.chip_im();
+        for (auto q : b.weighted_power()) os << " " << q;
+        expected_bank.push_back(os.str());
+      }
     }
   }
   {
@@ -138,10 +164,15 @@ TEST_P(ReceiverFamiliesIcarus, EveryCodeDecodesIdenticallyToTheModel) {
 
   std::ifstream ev(dir / "events.txt");
   std::vector<EventFixed> got;
+  std::vector<std::string> got_bank;
   std::string line;
   long xs = -1;
   while (std::getline(ev, line)) {
     std::istringstream is(line);
+    if (line.rfind("B ", 0) == 0) {
+      got_bank.push_back(line.substr(2));
+      continue;
+    }
     if (line.rfind("X ", 0) == 0) {
       std::string tag;
       is >> tag >> xs;
@@ -152,6 +183,11 @@ TEST_P(ReceiverFamiliesIcarus, EveryCodeDecodesIdenticallyToTheModel) {
     got.push_back(e);
   }
   EXPECT_EQ(xs, 0) << "X on an output after reset";
+  ASSERT_EQ(got_bank.size(), expected_bank.size()) << "decimated correlator outputs";
+  for (std::size_t i = 0; i < got_bank.size(); ++i) {
+    ASSERT_EQ(got_bank[i], expected_bank[i]) << "first mismatch: correlator output " << i
+                                             << " (index energy F_re F_im Q_1..Q_eta)";
+  }
   ASSERT_EQ(got.size(), expected.size());
   int codes_seen = 0;
   for (std::size_t i = 0; i < got.size(); ++i) {
@@ -160,8 +196,8 @@ TEST_P(ReceiverFamiliesIcarus, EveryCodeDecodesIdenticallyToTheModel) {
     codes_seen |= 1 << expected[i].code;
   }
   for (int j = 1; j <= d.family.eta(); ++j) EXPECT_TRUE(codes_seen & (1 << j)) << "code " << j << " not decoded";
-  std::cout << "iverilog " << GetParam() << ": " << x.size() << " samples, " << got.size()
-            << " events compared, 0 X\n";
+  std::cout << "iverilog " << GetParam() << ": " << x.size() << " samples, " << got_bank.size()
+            << " correlator outputs (F, Q of every code, energy) and " << got.size() << " events compared, 0 X\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(Paper, ReceiverFamiliesIcarus,
