@@ -1,5 +1,6 @@
 #include "model/receiver.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -20,6 +21,18 @@ namespace ranging {
 
 int ReceiverConfig::period() const { return static_cast<int>(std::lround(fs / carrier_hz)); }
 int ReceiverConfig::chip_samples() const { return cycles_per_chip * period(); }
+
+void fit_decimation_to_chip(ReceiverConfig& cfg) {
+  if (cfg.fs <= 0 || cfg.carrier_hz <= 0 || cfg.decimation < 1) return;
+  const int spc = cfg.chip_samples();
+  if (spc < 1 || spc % cfg.decimation == 0) return;
+  for (int d = std::min(cfg.decimation, spc); d >= 1; --d) {
+    if (spc % d == 0) {
+      cfg.decimation = d;
+      return;
+    }
+  }
+}
 
 void validate(const ReceiverConfig& cfg) {
   require_in_range("signal.carrier_hz", cfg.carrier_hz, 1e3, 1e8);

@@ -33,7 +33,7 @@ struct ReceiverConfig {
   // "ideal" matches the bare BPSK excitation.
   std::string reference = "received";
   TransducerParams reference_transducer;  // TX and RX of the template (received mode)
-  int decimation = 5;                    // D: the bank runs at fs / D
+  int decimation = 20;                   // D: the bank runs at fs / D
   double template_floor = 0.1;           // template tail trimmed below this fraction of its
                                          // peak (the paper's T_d threshold, b/10)
   BandpassFixedConfig bandpass;          // fixed-point word lengths of the filter
@@ -46,6 +46,11 @@ struct ReceiverConfig {
 
 // Throws InputError naming the field and valid range.
 void validate(const ReceiverConfig& cfg);
+
+// Lowers cfg.decimation to the largest divisor of the samples per chip that does not exceed it
+// (scenes whose families use another q than the configuration's, e.g. M3/M4 at q = 2 with the
+// default D = 20 -> 10). No-op when it already divides or fs is unset.
+void fit_decimation_to_chip(ReceiverConfig& cfg);
 
 // YAML (docs/configuration.md). Unknown keys, wrong types and out-of-range values are
 // errors naming the file, line and key.

@@ -207,15 +207,7 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
   if (s.receiver.reference != "files") rc.reference = s.receiver.reference;
   rc.reference_transducer.centre_hz = s.transducers.centre_hz;
   rc.reference_transducer.q = s.transducers.q;
-  if (rc.chip_samples() % rc.decimation != 0 && rc.fs > 0) {
-    // Adapt the decimation to a divisor of the samples per chip.
-    for (int d = rc.decimation; d >= 1; --d) {
-      if (rc.chip_samples() % d == 0) {
-        rc.decimation = d;
-        break;
-      }
-    }
-  }
+  fit_decimation_to_chip(rc);  // also per family in SceneSimulator (q_of)
   try {
     validate(rc);
     validate(TransducerParams{s.transducers.centre_hz, s.transducers.q, false}, s.fs);

@@ -361,6 +361,7 @@ SceneSimulator::Link& SceneSimulator::link(const std::string& family) {
   ReceiverConfig cfg = scene_.receiver.config;
   cfg.family = family;
   cfg.cycles_per_chip = scene_.excitation.q_of(family);
+  fit_decimation_to_chip(cfg);
   try {
     l->design = design_receiver(cfg);
   } catch (const InputError& e) {

@@ -12,6 +12,8 @@ if(EXISTS ${RANGING_GEN_SYSTEM}/rtl/ranging_system.vc)
   string(REGEX REPLACE "-GCLK_DIV=[^\n]+" "-GCLK_DIV=${RANGING_TB_CLK_DIV_VALUE}" RANGING_SYSTEM_VC_TEXT
          "${RANGING_SYSTEM_VC_TEXT}")
   file(WRITE ${RANGING_SYSTEM_TB_VC} "${RANGING_SYSTEM_VC_TEXT}")
+  # Regenerated parameters (ranging generate) must reach the testbench's copy.
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${RANGING_GEN_SYSTEM}/rtl/ranging_system.vc)
 endif()
 
 set(RANGING_SYSTEM_RTL

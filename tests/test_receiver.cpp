@@ -143,3 +143,23 @@ TEST(DemoCli, JsonContractAndBadInput) {
     EXPECT_TRUE(r.out.empty()) << bad;
   }
 }
+
+TEST(ReceiverConfig, FitDecimationToChipPicksTheLargestDivisor) {
+  ReceiverConfig cfg;  // 200 kHz, 5 MS/s: 25 samples per cycle
+  cfg.decimation = 20;
+  cfg.cycles_per_chip = 2;  // 50 samples per chip: 20 does not divide, 10 is the largest that does
+  fit_decimation_to_chip(cfg);
+  EXPECT_EQ(cfg.decimation, 10);
+  EXPECT_NO_THROW(validate(cfg));
+  cfg.cycles_per_chip = 4;  // 100: 10 divides, unchanged
+  fit_decimation_to_chip(cfg);
+  EXPECT_EQ(cfg.decimation, 10);
+  cfg.cycles_per_chip = 1;  // 25: 5
+  cfg.decimation = 20;
+  fit_decimation_to_chip(cfg);
+  EXPECT_EQ(cfg.decimation, 5);
+  cfg.cycles_per_chip = 4;
+  cfg.decimation = 30;  // 100: 25
+  fit_decimation_to_chip(cfg);
+  EXPECT_EQ(cfg.decimation, 25);
+}
