@@ -9,21 +9,49 @@
 //       candidate := {n, best, Q_prev, Q, second, norm}   (the best rho^2 = Q / norm so far)
 //   else if candidate && Q_next known && n - n_cand >= HOLDOFF: emit it
 //   Q_prev := this beat's Q vector
-// An event, computed with one sequential restoring divider (3 divisions):
-//   score  = min(2^SCORE_W-1, floor(Q / max(norm,1))),  margin = score - min(cap, floor(Q2/..))
-//   frac   = clamp(trunc((Q_next-Q_prev) 2^FRAC_W / (2 (2Q - Q_prev - Q_next))), +-2^(FRAC_W-1)),
-//            0 when the denominator is <= 0; arrival = n 2^FRAC_W + DECIM frac (signed).
-// Bit growth: THRESHOLD*norm SCORE_W+ENERGY_W (constant multiplier: shifts and adds);
-// denominator WEIGHTED_W+3 signed; numerator WEIGHTED_W+1+FRAC_W signed; quotients exact
-// (restoring division, truncation), then capped / clamped as above. No rounding elsewhere;
-// nothing can overflow.
-// Latency / throughput: a beat takes CODES+2 cycles (s_ready is low meanwhile): 11 cycles at
-// CODES = 9, well within the DECIM*8 cycles between the bank's outputs. An event adds
-// 3 divisions of DV_N = WEIGHTED_W+FRAC_W+1 cycles each (~170 cycles at the defaults) plus the
-// time the output waits for m_ready; s_ready stays low until the event is in the output
-// register, so the bank stalls and no beat or event is lost.
+// An event: score  = min(2^SCORE_W-1, floor(Q / max(norm,1))),  margin = score - same(Q2),
+//   frac = clamp(trunc((Q_next-Q_prev) 2^FRAC_W / (2 (2Q - Q_prev - Q_next))), +-2^(FRAC_W-1)),
+//   0 when the denominator is <= 0; arrival = n 2^FRAC_W + DECIM frac (signed).
+//
+// Architecture (sequential, one SB_MAC16, one EBR-inferred memory):
+//  - The beat is captured into a shift register; the scan looks at its bottom word only and
+//    shifts by WEIGHTED_W per clock (no CODES:1 multiplexer). Each word is also written into a
+//    2 x 2^clog2(CODES) x WEIGHTED_W memory (ping-pong by beat parity: 3 EBR at 48 bits), from
+//    which Q_prev = Q_best(previous beat) is read once after the scan.
+//  - Both exact tests are D = A1*B1 - A2*B2 on one 16x16 multiplier (registered operands and
+//    product), gate: A1*B1 = Q_best*1, A2*B2 = THRESHOLD*norm1; rho^2 test: Q_best*norm1_cand
+//    - Q_cand*norm1. Partial products are summed column by column (16-bit digits, i+j = k) in
+//    a small signed accumulator that is shifted right 16 bits after each column; the bits
+//    shifted out are >= 0 (arithmetic shift = floor), so D = acc 2^(16 cols) + L with
+//    0 <= L < 2^(16 cols): D >= 0 <=> acc >= 0 and D > 0 <=> acc > 0 || (acc == 0 && L != 0).
+//  - One restoring divider with only the quotient bits that can survive the cap / clamp:
+//    score: start with R = Q >> (SCORE_W+1) and run SCORE_W+1 steps over Q[SCORE_W:0]. The
+//      first step compares Q >> SCORE_W with norm1: if >=, floor(Q/norm1) >= 2^SCORE_W and the
+//      score is the cap (later bits are ignored); else Q >> SCORE_W < norm1 is a valid restoring
+//      remainder and the remaining SCORE_W steps give floor(Q/norm1) < 2^SCORE_W exactly.
+//    frac: the dividend is |dQ| 2^FRAC_W (its low FRAC_W bits are zero): start with R = |dQ|
+//      and run FRAC_W steps shifting in zeros. The first step compares |dQ| 2 = X >> (FRAC_W-1)
+//      with den: if >=, floor(X/den) >= 2^(FRAC_W-1) = HALF and the clamped result is HALF;
+//      else R < den holds and the remaining FRAC_W-1 steps give floor(X/den) < HALF exactly.
+//      The sign is applied afterwards (trunc toward zero = sign * floor(|X|/den)); den <= 0
+//      gives 0. Both rules equal the model's floor + min(cap) / trunc + clamp for every input.
+//  - dQ = Q_next - Q_prev and den = 4Q - 2(Q_prev + Q_next) are formed in two clocks (one
+//    adder each per clock) in the divider's registers.
+// Bit growth: MAC accumulator 36 + clog2(NA+NB) bits signed (sum of <= 2 min(NA,NB) products
+// of 32 bits plus the carried-in column); divider registers WEIGHTED_W+3 bits; quotients as
+// above. No rounding; nothing can overflow.
+// Latency / throughput (CODES=9, 48-bit Q, 29-bit norm: NA=3, NB=2 digits): a beat takes
+// 1 + CODES + 1 + (2 NA NB + 3) [gate] + (2 NA NB + 3) [rho^2, only if gate and a candidate
+// exists] + 1 cycles <= 42; an event adds 2 + FRAC_W + 1 + 2 (SCORE_W+2) + 1 = 48 cycles, so a
+// beat with an event is done in <= 90 cycles < the 120 between the bank's outputs (DECIM 20 x
+// 6 clocks): s_ready is high whenever the bank presents a beat. s_ready stays low while a beat
+// or an event is processed and until the event is in the output register (m_ready back-
+// pressure stalls the bank; nothing is lost).
 // Streams: valid/ready with AXI4-Stream rules (m_* stable while m_valid && !m_ready).
-// Reset: synchronous, active high, clears the candidate, Q_prev and the output register.
+// Reset: synchronous, active high, clears the control state, the candidate and the output
+// valid; the previous-beat vector reads as zeros until a beat has been taken.
+// Resources (yosys synth_ice40, default configuration): see the header of tb_peak_detector.cpp
+// and the commit message; 1 SB_MAC16, 3 SB_RAM40_4K.
 `default_nettype none
 
 module peak_detector #(
@@ -36,230 +64,327 @@ module peak_detector #(
 ) (
   input  wire clk, rst,
   input  wire s_valid, output wire s_ready,
+  // s_energy[ENERGY_SHIFT-1:0] is not needed (only norm = E >> ENERGY_SHIFT is used)
+  /* verilator lint_off UNUSEDSIGNAL */
   input  wire [CODES*WEIGHTED_W-1:0] s_weighted, input wire [ENERGY_W-1:0] s_energy,
+  /* verilator lint_on UNUSEDSIGNAL */
   input  wire [TIME_W-1:0] s_index,
   output wire m_valid, input wire m_ready,
   output wire [CODE_W-1:0]             m_code,
   output wire signed [TIME_W+FRAC_W:0] m_arrival,
   output wire [SCORE_W-1:0]            m_score, m_margin
 );
-  function integer clog2;
-    input integer v;
-    integer r;
-    begin
-      r = 0;
-      while ((1 << r) < v) r = r + 1;
-      clog2 = (r < 1) ? 1 : r;
-    end
-  endfunction
-  function integer imax;
-    input integer a, b;
-    begin
-      imax = (a > b) ? a : b;
-    end
-  endfunction
-
-  localparam integer QW     = WEIGHTED_W;
-  localparam integer JI_W   = clog2(CODES + 1);
-  localparam integer DV_N   = WEIGHTED_W + FRAC_W + 1;          // dividend bits
-  localparam integer DV_D   = imax(ENERGY_W, WEIGHTED_W + 3);    // divisor bits
-  localparam integer DC_W   = clog2(DV_N + 1);
-  localparam integer THR_W  = SCORE_W + ENERGY_W;
-  localparam integer CMP_W  = imax(THR_W, QW) + 1;              // gate comparison
-  localparam integer ARR_W  = TIME_W + FRAC_W + 1;
-  localparam integer FR_W   = FRAC_W + 2;                        // signed fraction
+  localparam integer QW    = WEIGHTED_W;
+  localparam integer NW    = (ENERGY_W - ENERGY_SHIFT > 1) ? ENERGY_W - ENERGY_SHIFT : 1;  // norm bits
+  localparam integer JB    = (CODES > 1) ? $clog2(CODES) : 1;     // code index bits
+  localparam integer NA    = (QW + 15) / 16;                      // 16-bit digits of Q
+  localparam integer NB    = (NW + 15) / 16;                      // 16-bit digits of norm
+  localparam integer NK    = NA + NB - 1;                         // product columns
+  localparam integer KW    = $clog2(NK + 1);
+  localparam integer IW    = $clog2(NA + 1);
+  localparam integer AW    = 36 + $clog2(NA + NB);                // MAC accumulator
+  localparam integer W     = (QW + 3 > NW + 1) ? QW + 3 : NW + 1;  // divider registers
+  localparam integer KM    = (SCORE_W + 1 > FRAC_W) ? SCORE_W + 1 : FRAC_W;  // quotient bits
+  localparam integer CW    = $clog2(KM + 1);
+  localparam integer ARR_W = TIME_W + FRAC_W + 1;
+  localparam integer FR_W  = FRAC_W + 2;                          // signed fraction
   localparam integer CODES_I = CODES;
-  localparam [JI_W-1:0] CODES_N = CODES_I[JI_W-1:0];
+  localparam [JB-1:0] LAST_J = CODES_I[JB-1:0] - 1'b1;
   localparam integer HOLDOFF_I = HOLDOFF;
   localparam [TIME_W-1:0] HOLD_T = {{(TIME_W-32){1'b0}}, HOLDOFF_I[31:0]};  // TIME_W >= 32
-  localparam [DC_W-1:0] DV_N_C = DV_N[DC_W-1:0];
   localparam [SCORE_W-1:0] CAP = {SCORE_W{1'b1}};
   localparam integer HALF_I = (FRAC_W > 0) ? (1 << (FRAC_W - 1)) : 0;
-  localparam [DV_N-1:0] HALF = {{(DV_N-32){1'b0}}, HALF_I[31:0]};
+  localparam [FR_W-1:0] HALF = HALF_I[FR_W-1:0];
+  localparam integer KS_I = SCORE_W + 1, KF_I = FRAC_W;
+  localparam [CW-1:0] KS = KS_I[CW-1:0];
+  localparam [CW-1:0] KF = KF_I[CW-1:0];
+  localparam integer KF1 = (FRAC_W > 0) ? FRAC_W - 1 : 0;
+  localparam [KW-1:0] KLAST = NK[KW-1:0] - 1'b1;
+  localparam integer NB_I = NB, NA_I = NA;
+  localparam [KW-1:0] NB_K = NB_I[KW-1:0];
+  localparam [IW-1:0] NA_LAST = NA_I[IW-1:0] - 1'b1;
 
-  localparam [3:0] S_IDLE = 4'd0, S_SCAN = 4'd1, S_DECIDE = 4'd2, S_DIV = 4'd3,
-                   S_NEXTDIV = 4'd4, S_OUT = 4'd5;
+  localparam [3:0] S_IDLE = 4'd0, S_SCAN = 4'd1, S_MAC = 4'd2, S_DECIDE = 4'd3,
+                   S_P0 = 4'd4, S_P1 = 4'd5, S_DIV = 4'd6, S_NEXT = 4'd7, S_OUT = 4'd8;
   reg [3:0] state;
 
-  // input beat
-  reg [CODES*WEIGHTED_W-1:0] q_r, prev;
-  reg [ENERGY_W-1:0] e_r;
+  // ---------------------------------------------------------------- input beat and scan
+  reg [CODES*QW-1:0] q_r;            // shifts down one code per scan clock
+  reg [NW-1:0]       nrm;            // norm = E >> ENERGY_SHIFT
   reg [TIME_W-1:0]   n_r;
-  // scan
-  reg [JI_W-1:0]     j;
-  reg [JI_W-1:0]     best;
+  reg [JB-1:0]       j;
+  reg [JB-1:0]       best;
   reg [QW-1:0]       best_q, second;
-  // candidate
+  reg                par, prev_ok;   // memory half of this beat; a previous beat exists
+  wire [QW-1:0] head = q_r[QW-1:0];
+
+  // previous / current beat's Q vectors (ping-pong halves of one memory -> EBR)
+  reg [QW-1:0] pmem [0:(2 << JB)-1];
+  reg [QW-1:0] p_rd;
+  always @(posedge clk) begin
+    if (state == S_SCAN) pmem[{par, j}] <= head;
+    if (state == S_MAC) p_rd <= pmem[{~par, best}];
+  end
+
+  // ---------------------------------------------------------------- candidate
   reg                c_valid, c_has_next;
   reg [TIME_W-1:0]   c_n;
-  reg [JI_W-1:0]     c_code;
+  reg [JB-1:0]       c_code;
   reg [QW-1:0]       c_qp, c_q, c_qn, c_q2;
-  reg [ENERGY_W-1:0] c_norm;
-  // event under computation
-  reg [TIME_W-1:0]   ev_n;
-  reg [JI_W-1:0]     ev_code;
-  reg [QW-1:0]       ev_q2;
-  reg                ev_neg, ev_den_pos;
-  reg [DV_N-1:0]     ev_num_mag;
-  reg [DV_D-1:0]     ev_den;
-  reg [1:0]          div_no;         // 0: score, 1: second score, 2: fraction
-  reg [SCORE_W-1:0]  sc1, sc2;
-  // divider
-  reg [DV_N-1:0]     dv_q;           // dividend shifting out / quotient shifting in
-  reg [DV_D-1:0]     dv_r;           // remainder (< divisor)
-  reg [DV_D-1:0]     dv_d;
-  reg [DC_W-1:0]     dv_cnt;
+  reg [NW-1:0]       c_norm1;
+
+  wire [NW-1:0] norm1 = {nrm[NW-1:1], nrm[0] | (nrm == {NW{1'b0}})};
+  wire [ENERGY_W:0] nrm_x = {{(ENERGY_W-NW+1){1'b0}}, nrm};
+  wire min_ok = nrm_x >= {1'b0, MIN_NORM};
+
+  // ---------------------------------------------------------------- MAC: D = A1 B1 - A2 B2
+  reg            m_run, m_mode;      // mode 0: gate, 1: rho^2 comparison
+  reg            m_done, gate_r;
+  reg [KW-1:0]   mk;                 // column
+  reg [IW-1:0]   mi;                 // digit of A
+  reg            mp;                 // 0: A1 B1 (+), 1: A2 B2 (-)
+  reg [15:0]     ma, mb;
+  reg [31:0]     prod;
+  reg            v1, s1, e1, v2, s2, e2;   // valid / subtract / column end, per stage
+  reg            fin1, fin2;
+  reg signed [AW-1:0] acc;
+  reg            acc_nz;
+
+  // digit vectors, one spare top bit (never selected) so that no replication is zero-width
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [NA*16:0] a1_v = {{(NA*16-QW+1){1'b0}}, best_q};
+  wire [NA*16:0] a2_v = m_mode ? {{(NA*16-QW+1){1'b0}}, c_q}
+                               : {{(NA*16-SCORE_W+1){1'b0}}, THRESHOLD};
+  wire [NB*16:0] b1_v = m_mode ? {{(NB*16-NW+1){1'b0}}, c_norm1} : {{NB*16{1'b0}}, 1'b1};
+  wire [NB*16:0] b2_v = {{(NB*16-NW+1){1'b0}}, norm1};
+  /* verilator lint_on UNUSEDSIGNAL */
+  // digit range of column k: i in [max(0, k-NB+1), min(k, NA-1)], j = k - i
+  wire [KW-1:0] mk1   = mk + 1'b1;
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [KW-1:0] lo1_k = mk1 - NB_K + 1'b1;
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [IW-1:0] i_lo1 = (mk1 >= NB_K) ? lo1_k[IW-1:0] : {IW{1'b0}};
+  wire [KW:0]   na_last_k = {{(KW-IW+1){1'b0}}, NA_LAST};
+  wire [IW-1:0] i_hi  = ({1'b0, mk} > na_last_k) ? NA_LAST : mk[IW-1:0];
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [KW:0]   mj_x  = {1'b0, mk} - {{(KW-IW+1){1'b0}}, mi};
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [KW-1:0] mj    = mj_x[KW-1:0];
+  wire [15:0] a_dig = mp ? a2_v[mi*16 +: 16] : a1_v[mi*16 +: 16];
+  wire [15:0] b_dig = mp ? b2_v[mj*16 +: 16] : b1_v[mj*16 +: 16];
+  wire signed [AW-1:0] prod_x = $signed({{(AW-32){1'b0}}, prod});
+  wire signed [AW-1:0] acc_sum = s2 ? acc - prod_x : acc + prod_x;
+  wire d_ge0 = !acc[AW-1];
+  wire d_gt0 = d_ge0 && ((acc != 0) || acc_nz);
+
+  // ---------------------------------------------------------------- event / divider
+  reg [W-1:0]    dv_r, dv_d;
+  reg [KM-1:0]   dv_q;
+  reg [CW-1:0]   dv_cnt;
+  reg [1:0]      dsel;               // 0: fraction, 1: score, 2: second score
+  reg            ev_neg;
+  reg [FR_W-1:0] fmag;
+  reg [SCORE_W-1:0] sc1;
+  wire [W:0]   dv_sh  = {dv_r, dv_q[KM-1]};
+  wire [W+1:0] dv_sub = {1'b0, dv_sh} - {2'b0, dv_d};
+  wire dv_ge = !dv_sub[W+1];
+  wire [CW-1:0] dv_k = (dsel == 2'd0) ? KF : KS;
+  wire [SCORE_W-1:0] score_now = dv_q[SCORE_W] ? CAP : dv_q[SCORE_W-1:0];
+  // quotient of the fraction division: its low FRAC_W bits (< HALF when the top one is 0)
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [KM+FR_W-1:0] fq_x = {{FR_W{1'b0}}, dv_q};
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [FR_W-1:0] fq = fq_x[FR_W-1:0] & {{2{1'b0}}, {FRAC_W{1'b1}}};
+  wire den_pos = !dv_d[W-1] && (dv_d != {W{1'b0}});
+  wire [QW:0] q_hi  = {1'b0, c_q}  >> (SCORE_W + 1);
+  wire [QW:0] q2_hi = {1'b0, c_q2} >> (SCORE_W + 1);
+  // Q[SCORE_W:0] at the top of the KM-bit dividend register
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [KM+SCORE_W:0] q_lo_x  = {c_q[SCORE_W:0],  {KM{1'b0}}};
+  wire [KM+SCORE_W:0] q2_lo_x = {c_q2[SCORE_W:0], {KM{1'b0}}};
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [KM-1:0] q_lo  = q_lo_x[KM+SCORE_W -: KM];
+  wire [KM-1:0] q2_lo = q2_lo_x[KM+SCORE_W -: KM];
+
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [CODE_W+JB-1:0] code_x = {{CODE_W{1'b0}}, c_code};
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire hn_now = c_valid && !c_has_next;   // candidate takes Q_next this beat (scan)
+  wire [TIME_W-1:0] since = n_r - c_n;
+  wire emit = c_valid && (c_has_next || hn_now) && since >= HOLD_T;
+
   // output
   reg                m_valid_r;
   reg [CODE_W-1:0]   o_code;
   reg [ARR_W-1:0]    o_arrival;
   reg [SCORE_W-1:0]  o_score, o_margin;
+  localparam integer DECIM_I = DECIM;
+  localparam signed [ARR_W-1:0] DECIM_A = {{(ARR_W-32){1'b0}}, DECIM_I[31:0]};
+  wire signed [FR_W-1:0] frac = ev_neg ? -$signed(fmag) : $signed(fmag);
+  wire signed [ARR_W-1:0] frac_x = {{(ARR_W-FR_W){frac[FR_W-1]}}, frac};
+  wire signed [ARR_W-1:0] arrival = $signed({1'b0, c_n, {FRAC_W{1'b0}}}) + frac_x * DECIM_A;
 
   assign s_ready = (state == S_IDLE);
 
-  wire [QW-1:0] q_j     = q_r[j*QW +: QW];
-  wire [QW-1:0] q_cand  = q_r[c_code*QW +: QW];
-  wire [QW-1:0] prev_b  = prev[best*QW +: QW];
-  wire [ENERGY_W-1:0] norm  = e_r >> ENERGY_SHIFT;
-  wire [ENERGY_W-1:0] norm1 = (norm == {ENERGY_W{1'b0}}) ? {{(ENERGY_W-1){1'b0}}, 1'b1} : norm;
-  wire [CMP_W-1:0] thr_norm = {{(CMP_W-SCORE_W){1'b0}}, THRESHOLD} * {{(CMP_W-ENERGY_W){1'b0}}, norm1};
-  wire gate = ({{(CMP_W-QW){1'b0}}, best_q} >= thr_norm) && (norm >= MIN_NORM);
-  wire hn_now = c_valid && !c_has_next;               // candidate takes Q_next this beat
-  wire hn     = c_has_next || hn_now;
-  wire [QW-1:0] qn = hn_now ? q_cand : c_qn;
-  wire [TIME_W-1:0] since = n_r - c_n;
-  // rho^2 of the best code beats the candidate's: Q / norm > Q_c / norm_c, cross-multiplied.
-  wire [ENERGY_W-1:0] c_norm1 = (c_norm == {ENERGY_W{1'b0}}) ? {{(ENERGY_W-1){1'b0}}, 1'b1} : c_norm;
-  wire [QW+ENERGY_W-1:0] better_lhs = {{ENERGY_W{1'b0}}, best_q} * {{QW{1'b0}}, c_norm1};
-  wire [QW+ENERGY_W-1:0] better_rhs = {{ENERGY_W{1'b0}}, c_q} * {{QW{1'b0}}, norm1};
-  wire better = better_lhs > better_rhs;
-
-  // Fraction operands of the candidate being emitted (computed in DECIDE from c_* and qn).
-  wire signed [QW+2:0] den_s = ({3'b0, c_q} <<< 2) - ({3'b0, c_qp} <<< 1) - ({3'b0, qn} <<< 1);
-  wire signed [QW+1:0] dnum  = {2'b0, qn} - {2'b0, c_qp};
-  // |Q_next - Q_prev| < 2^QW: the top two bits of the magnitude are zero.
-  /* verilator lint_off UNUSEDSIGNAL */
-  wire [QW+1:0] dnum_mag = dnum[QW+1] ? -dnum : dnum;
-  /* verilator lint_on UNUSEDSIGNAL */
-
-  // One restoring-division step.
-  wire [DV_D:0] dv_sh  = {dv_r[DV_D-1:0], dv_q[DV_N-1]};
-  wire [DV_D:0] dv_sub = dv_sh - {1'b0, dv_d};
-  wire dv_ge = !dv_sub[DV_D];
-
-  // Results of the finished division (quotient in dv_q).
-  wire [SCORE_W-1:0] score_now = (|(dv_q >> SCORE_W)) ? CAP : dv_q[SCORE_W-1:0];
-  // frac_mag <= HALF: only its low FR_W bits can be non-zero.
-  /* verilator lint_off UNUSEDSIGNAL */
-  wire [DV_N-1:0] frac_mag = (!ev_den_pos) ? {DV_N{1'b0}} : (dv_q > HALF ? HALF : dv_q);
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire signed [FR_W-1:0] frac = ev_neg ? -$signed(frac_mag[FR_W-1:0]) : $signed(frac_mag[FR_W-1:0]);
-  localparam integer DECIM_I = DECIM;
-  localparam signed [ARR_W-1:0] DECIM_A = {{(ARR_W-32){1'b0}}, DECIM_I[31:0]};
-  wire signed [ARR_W-1:0] frac_x = {{(ARR_W-FR_W){frac[FR_W-1]}}, frac};
-  wire signed [ARR_W-1:0] arrival = $signed({1'b0, ev_n, {FRAC_W{1'b0}}}) + frac_x * DECIM_A;
+  // MAC pipeline (datapath, no reset needed: m_run / v1 / v2 are controlled below)
+  always @(posedge clk) begin
+    ma <= a_dig;
+    mb <= b_dig;
+    prod <= ma * mb;
+  end
 
   always @(posedge clk) begin
     if (rst) begin
       state <= S_IDLE;
-      q_r <= 0; prev <= 0; e_r <= 0; n_r <= 0;
-      j <= 0; best <= 0; best_q <= 0; second <= 0;
-      c_valid <= 1'b0; c_has_next <= 1'b0; c_n <= 0; c_code <= 0;
-      c_qp <= 0; c_q <= 0; c_qn <= 0; c_q2 <= 0; c_norm <= 0;
-      ev_n <= 0; ev_code <= 0; ev_q2 <= 0;
-      ev_neg <= 1'b0; ev_den_pos <= 1'b0; ev_num_mag <= 0; ev_den <= 0;
-      div_no <= 0; sc1 <= 0; sc2 <= 0;
-      dv_q <= 0; dv_r <= 0; dv_d <= 0; dv_cnt <= 0;
-      m_valid_r <= 1'b0; o_code <= 0; o_arrival <= 0; o_score <= 0; o_margin <= 0;
+      par <= 1'b0; prev_ok <= 1'b0;
+      c_valid <= 1'b0; c_has_next <= 1'b0;
+      m_run <= 1'b0; m_done <= 1'b0;
+      v1 <= 1'b0; v2 <= 1'b0; fin1 <= 1'b0; fin2 <= 1'b0;
+      m_valid_r <= 1'b0;
     end else begin
       if (m_valid_r && m_ready) m_valid_r <= 1'b0;
+      // MAC pipeline control and accumulator
+      v2 <= v1; s2 <= s1; e2 <= e1; fin2 <= fin1;
+      v1 <= 1'b0; fin1 <= 1'b0;
+      if (v2) begin
+        if (e2) begin
+          acc <= acc_sum >>> 16;
+          acc_nz <= acc_nz | (acc_sum[15:0] != 16'd0);
+        end else begin
+          acc <= acc_sum;
+        end
+      end
+      m_done <= fin2;
+      if (m_run) begin
+        v1 <= 1'b1; s1 <= mp; e1 <= mp && (mi == i_hi);
+        mp <= ~mp;
+        if (mp) begin
+          if (mi == i_hi) begin
+            mk <= mk1;
+            mi <= i_lo1;
+            if (mk == KLAST) begin
+              m_run <= 1'b0;
+              fin1 <= 1'b1;
+            end
+          end else begin
+            mi <= mi + 1'b1;
+          end
+        end
+      end
       case (state)
         S_IDLE: if (s_valid) begin
           q_r <= s_weighted;
-          e_r <= s_energy;
+          nrm <= s_energy[ENERGY_W-1 -: NW];
           n_r <= s_index;
           best <= 0;
-          best_q <= s_weighted[QW-1:0];
+          best_q <= 0;
           second <= 0;
-          j <= 1;
-          state <= (CODES > 1) ? S_SCAN : S_DECIDE;
+          j <= 0;
+          state <= S_SCAN;
         end
         S_SCAN: begin
-          if (q_j > best_q) begin
+          // strict > with the running best starting at 0: lowest index on ties
+          if (head > best_q) begin
             second <= best_q;
-            best_q <= q_j;
+            best_q <= head;
             best <= j;
-          end else if (q_j > second) begin
-            second <= q_j;
+          end else if (head > second) begin
+            second <= head;
           end
+          if (hn_now && j == c_code) c_qn <= head;
+          q_r <= q_r >> QW;
           j <= j + 1'b1;
-          if (j + 1'b1 == CODES_N) state <= S_DECIDE;
+          if (j == LAST_J) begin
+            state <= S_MAC;
+            m_run <= 1'b1; m_mode <= 1'b0;
+            mk <= 0; mi <= 0; mp <= 1'b0;
+            acc <= 0; acc_nz <= 1'b0;
+          end
+        end
+        S_MAC: if (m_done) begin
+          if (!m_mode) begin
+            gate_r <= d_ge0 && min_ok;
+            if (d_ge0 && min_ok && c_valid) begin
+              m_run <= 1'b1; m_mode <= 1'b1;
+              mk <= 0; mi <= 0; mp <= 1'b0;
+              acc <= 0; acc_nz <= 1'b0;
+            end else begin
+              state <= S_DECIDE;
+            end
+          end else begin
+            state <= S_DECIDE;
+          end
         end
         S_DECIDE: begin
-          prev <= q_r;
+          par <= ~par;
+          prev_ok <= 1'b1;
           state <= S_IDLE;
-          if (gate && (!c_valid || better)) begin
+          // gate_r && m_mode: the rho^2 test ran (a candidate exists); its result is d_gt0.
+          if (gate_r && (!c_valid || d_gt0)) begin
             c_valid <= 1'b1;
             c_has_next <= 1'b0;
             c_n <= n_r;
             c_code <= best;
-            c_qp <= prev_b;
+            c_qp <= prev_ok ? p_rd : {QW{1'b0}};
             c_q <= best_q;
-            c_qn <= 0;
             c_q2 <= second;
-            c_norm <= norm;
-          end else if (c_valid && hn && since >= HOLD_T) begin
+            c_norm1 <= norm1;
+          end else if (emit) begin
             c_valid <= 1'b0;
             c_has_next <= 1'b0;
-            ev_n <= c_n;
-            ev_code <= c_code;
-            ev_q2 <= c_q2;
-            ev_den_pos <= !den_s[QW+2] && (den_s != 0);
-            ev_den <= den_s[DV_D-1:0];
-            ev_neg <= dnum[QW+1];
-            ev_num_mag <= {1'b0, dnum_mag[QW-1:0], {FRAC_W{1'b0}}};  // |Q_next - Q_prev| < 2^QW
-            div_no <= 0;
-            // division 0: Q / max(norm, 1)
-            dv_q <= {{(DV_N-QW){1'b0}}, c_q};
-            dv_d <= {{(DV_D-ENERGY_W){1'b0}}, (c_norm == {ENERGY_W{1'b0}}) ? {{(ENERGY_W-1){1'b0}}, 1'b1} : c_norm};
-            dv_r <= 0;
-            dv_cnt <= 0;
-            state <= S_DIV;
+            state <= S_P0;
           end else begin
-            c_has_next <= hn;
-            c_qn <= qn;
+            c_has_next <= c_valid;
           end
         end
-        S_DIV: begin
-          dv_r <= dv_ge ? dv_sub[DV_D-1:0] : dv_sh[DV_D-1:0];
-          dv_q <= {dv_q[DV_N-2:0], dv_ge};
-          dv_cnt <= dv_cnt + 1'b1;
-          if (dv_cnt + 1'b1 == DV_N_C) state <= S_NEXTDIV;
+        // dQ into dv_r, Q_prev + Q_next into dv_d
+        S_P0: begin
+          dv_r <= {{(W-QW){1'b0}}, c_qn} - {{(W-QW){1'b0}}, c_qp};
+          dv_d <= {{(W-QW){1'b0}}, c_qn} + {{(W-QW){1'b0}}, c_qp};
+          state <= S_P1;
         end
-        S_NEXTDIV: begin
-          dv_r <= 0;
+        // |dQ| (restoring remainder), den = 4Q - 2(Q_prev + Q_next)
+        S_P1: begin
+          ev_neg <= dv_r[W-1];
+          dv_r <= dv_r[W-1] ? -dv_r : dv_r;
+          dv_d <= ({{(W-QW){1'b0}}, c_q} << 2) - (dv_d << 1);
+          dv_q <= 0;
           dv_cnt <= 0;
-          if (div_no == 2'd0) begin
+          dsel <= 2'd0;
+          fmag <= 0;
+          state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
+        end
+        S_DIV: begin
+          dv_r <= dv_ge ? dv_sub[W-1:0] : dv_sh[W-1:0];
+          dv_q <= {dv_q[KM-2:0], dv_ge};
+          dv_cnt <= dv_cnt + 1'b1;
+          if (dv_cnt + 1'b1 == dv_k) state <= S_NEXT;
+        end
+        S_NEXT: begin
+          dv_cnt <= 0;
+          dv_d <= {{(W-NW){1'b0}}, c_norm1};
+          state <= S_DIV;
+          if (dsel == 2'd0) begin
+            if (FRAC_W > 0 && den_pos)
+              fmag <= dv_q[KF1] ? HALF : fq;
+            dsel <= 2'd1;
+            dv_r <= {{(W-QW-1){1'b0}}, q_hi};
+            dv_q <= q_lo;
+          end else if (dsel == 2'd1) begin
             sc1 <= score_now;
-            div_no <= 2'd1;
-            dv_q <= {{(DV_N-QW){1'b0}}, ev_q2};
-            state <= S_DIV;
-          end else if (div_no == 2'd1) begin
-            sc2 <= score_now;
-            div_no <= 2'd2;
-            dv_q <= ev_num_mag;
-            dv_d <= ev_den;
-            state <= S_DIV;
+            dsel <= 2'd2;
+            dv_r <= {{(W-QW-1){1'b0}}, q2_hi};
+            dv_q <= q2_lo;
           end else begin
             state <= S_OUT;
           end
         end
         S_OUT: if (!m_valid_r) begin
           m_valid_r <= 1'b1;
-          o_code <= ev_code + 1'b1;
+          o_code <= code_x[CODE_W-1:0] + 1'b1;
           o_arrival <= arrival;
           o_score <= sc1;
-          o_margin <= sc1 - sc2;
+          o_margin <= sc1 - score_now;
           state <= S_IDLE;
         end
         default: state <= S_IDLE;
