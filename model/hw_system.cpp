@@ -42,7 +42,32 @@ std::uint32_t speed_register(double c, double fs, int c_frac) {
   return static_cast<std::uint32_t>(v);
 }
 
-SystemDesign system_design(const ReceiverDesign& d, const SystemOptions& opt) {
+Ice40Pll ice40_pll(double f_in, double f_out) {
+  for (int divr = 0; divr <= 15; ++divr) {
+    const double pfd = f_in / (divr + 1);
+    if (pfd < 10e6 || pfd > 133e6) continue;
+    for (int divf = 0; divf <= 127; ++divf) {
+      const double vco = pfd * (divf + 1);
+      if (vco < 533e6 || vco > 1066e6) continue;
+      for (int divq = 1; divq <= 6; ++divq) {
+        const double out = vco / static_cast<double>(1 << divq);
+        if (std::abs(out - f_out) > 1e-3) continue;
+        Ice40Pll p{divr, divf, divq, 0, pfd, vco, out};
+        // icepll's loop filter ranges by F_PFD
+        p.filter_range = pfd < 17e6 ? 1 : pfd < 26e6 ? 2 : pfd < 44e6 ? 3 : pfd < 66e6 ? 4 : pfd < 101e6 ? 5 : 6;
+        return p;
+      }
+    }
+  }
+  std::ostringstream os;
+  os << "clk_hz: " << f_out << " Hz cannot be made exactly from the " << f_in
+     << " Hz oscillator by the iCE40 PLL (e.g. 30 MHz or 45 MHz from 12 MHz can)";
+  throw InputError(os.str());
+}
+
+SystemDesign system_design(const ReceiverDesign& d, const SystemOptions& options) {
+  SystemOptions opt = options;
+  if (opt.clk_hz == 0) opt.clk_hz = d.config.clock_hz;
   require_in_range("clk_hz", opt.clk_hz, 1e6, 500e6);
   require_in_range("max_range_m", opt.max_range_m, 0.01, 100.0);
   require_in_range("baud", opt.baud, 1200.0, 12e6);
@@ -258,7 +283,18 @@ std::map<std::string, std::string> generate_system_files(const ReceiverDesign& d
   j["baud_div"] = s.baud_div;
   j["frac_bits"] = s.frac_w;
   j["offsets"] = s.offsets;
+  // The board's PLL (boards/icebreaker/ice40_top.v includes this file).
+  const Ice40Pll pll = ice40_pll(12e6, s.clk_hz);
+  std::ostringstream vh;
+  vh << head << "// iCEBreaker SB_PLL40_PAD settings: 12 MHz -> " << pll.f_out / 1e6 << " MHz (F_PFD "
+     << pll.f_pfd / 1e6 << " MHz, F_VCO " << pll.f_vco / 1e6 << " MHz), as `icepll -i 12 -o " << s.clk_hz / 1e6
+     << "`.\n"
+     << "`define RANGING_PLL_DIVR " << pll.divr << "\n`define RANGING_PLL_DIVF " << pll.divf
+     << "\n`define RANGING_PLL_DIVQ " << pll.divq << "\n`define RANGING_PLL_FILTER_RANGE " << pll.filter_range
+     << "\n`define RANGING_CLK_HZ " << static_cast<std::int64_t>(std::llround(s.clk_hz)) << "\n";
+  j["pll"] = {{"divr", pll.divr}, {"divf", pll.divf}, {"divq", pll.divq}, {"filter_range", pll.filter_range}};
   std::map<std::string, std::string> files;
+  files["rtl/ice40_pll.vh"] = vh.str();
   files["rtl/ranging_system_top.v"] = v.str();
   files["rtl/ranging_system.vc"] = vc.str();
   files["system.json"] = j.dump(2) + "\n";

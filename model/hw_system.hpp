@@ -14,7 +14,7 @@ namespace ranging {
 
 // Board and deployment choices that the receiver configuration does not carry.
 struct SystemOptions {
-  double clk_hz = 45e6;           // system clock (iCEBreaker: PLL 12 -> 45 MHz, exact)
+  double clk_hz = 0;              // system clock; 0: the configuration's hardware.clock_hz
   double max_range_m = 1.0;       // L of eq. 3/4 (the paper: 100-1000 mm)
   double speed_of_sound = 340.0;  // m/s, loaded into the speed register at reset
   double baud = 1.5e6;            // UART
@@ -73,8 +73,17 @@ class TofDistanceModel {
 std::vector<std::int8_t> system_drive(const ReceiverDesign& design, const SystemDesign& s,
                                       std::size_t samples);
 
+// iCE40 SB_PLL40 settings (SIMPLE feedback) that make f_out from f_in exactly, searched like
+// icestorm's icepll: F_PFD = f_in / (DIVR+1) in [10, 133] MHz, F_VCO = F_PFD (DIVF+1) in
+// [533, 1066] MHz, f_out = F_VCO / 2^DIVQ. Throws InputError naming clk_hz when none is exact.
+struct Ice40Pll {
+  int divr = 0, divf = 0, divq = 0, filter_range = 0;
+  double f_pfd = 0, f_vco = 0, f_out = 0;
+};
+Ice40Pll ice40_pll(double f_in, double f_out);
+
 // Generated files (relative to the generator's output folder): rtl/ranging_system_top.v,
-// rtl/ranging_system.vc, system.json.
+// rtl/ranging_system.vc, rtl/ice40_pll.vh (the iCEBreaker PLL: 12 MHz -> clk_hz), system.json.
 std::map<std::string, std::string> generate_system_files(const ReceiverDesign& design,
                                                          const std::string& origin,
                                                          const SystemOptions& opt = {});

@@ -21,6 +21,7 @@ namespace ranging {
 
 int ReceiverConfig::period() const { return static_cast<int>(std::lround(fs / carrier_hz)); }
 int ReceiverConfig::chip_samples() const { return cycles_per_chip * period(); }
+int ReceiverConfig::sample_cycles() const { return static_cast<int>(std::lround(clock_hz / fs)); }
 
 void fit_decimation_to_chip(ReceiverConfig& cfg) {
   if (cfg.fs <= 0 || cfg.carrier_hz <= 0 || cfg.decimation < 1) return;
@@ -56,6 +57,15 @@ void validate(const ReceiverConfig& cfg) {
   }
   validate(cfg.reference_transducer, cfg.fs);
   validate(cfg.detector);
+  require_in_range("hardware.clock_hz", cfg.clock_hz, 1e6, 500e6);
+  const double cycles = cfg.clock_hz / cfg.fs;
+  if (std::abs(cycles - std::round(cycles)) > 1e-9 * cycles || cycles < 1) {
+    std::ostringstream os;
+    os.precision(12);
+    os << "hardware.clock_hz: " << cfg.clock_hz << " must be an integer multiple (>= 1) of signal.fs ("
+       << cfg.fs << "): the RTL takes one sample every clock_hz / fs clocks";
+    throw InputError(os.str());
+  }
   if (cfg.architecture != "baseband") {
     throw InputError("architecture: '" + cfg.architecture +
                      "' is not implemented by the fixed-point model; valid: baseband");
@@ -164,6 +174,7 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
     r.get("min_energy", d.min_energy);
     r.get("frac_bits", d.frac_bits);
   });
+  section(top, "hardware", [&](Reader& r) { r.get("clock_hz", cfg.clock_hz); });
   top.finish();
   cfg.correlator.data_bits = cfg.bandpass.data_bits;
   cfg.correlator.data_frac = cfg.bandpass.data_frac;
@@ -214,6 +225,7 @@ std::string receiver_config_yaml(const ReceiverConfig& c) {
   const auto& d = c.detector;
   os << "detector:\n  threshold: " << d.threshold << "\n  holdoff: " << autoint(d.holdoff)
      << "\n  min_energy: " << d.min_energy << "\n  frac_bits: " << d.frac_bits << "\n";
+  os << "hardware:\n  clock_hz: " << c.clock_hz << "\n";
   return os.str();
 }
 

@@ -39,9 +39,13 @@ struct ReceiverConfig {
   BandpassFixedConfig bandpass;          // fixed-point word lengths of the filter
   CorrelatorFixedConfig correlator;      // ... of the correlator bank
   DetectorConfig detector;
+  // hardware.clock_hz: the system clock the generated RTL is scheduled for (the iCEBreaker's
+  // PLL makes it from 12 MHz); clock_hz / fs clocks per input sample, an integer.
+  double clock_hz = 30e6;
 
   int period() const;        // fs / f, samples per carrier cycle (validated integer)
   int chip_samples() const;  // q fs / f
+  int sample_cycles() const; // clock_hz / fs (validated integer)
 };
 
 // Throws InputError naming the field and valid range.

@@ -98,7 +98,9 @@ sources=("${receiver_rtl[@]}" "$gen/rtl/receiver_top.v" "${system_rtl[@]}" "$gen
 # --- iCE40 -----------------------------------------------------------------------------------
 log "yosys synth_ice40 -dsp (log: $out/yosys_ice40.log)"
 read_cmd=""
-for f in "${sources[@]}" "$board/ice40_top.v"; do read_cmd+="read_verilog -defer $f; "; done
+for f in "${sources[@]}"; do read_cmd+="read_verilog -defer $f; "; done
+# The board top includes the generated PLL settings (rtl/ice40_pll.vh).
+read_cmd+="read_verilog -defer -I$gen/rtl $board/ice40_top.v; "
 t0=$(date +%s)
 if ! nice yosys -q -l "$out/yosys_ice40.log" -p "$read_cmd hierarchy -top ice40_top; \
     synth_ice40 -dsp -top ice40_top -json $out/ice40_top.json; \

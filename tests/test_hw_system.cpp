@@ -38,8 +38,9 @@ TEST(HwSystem, PeriodFollowsEquations3And4) {
   const double v = vmax(design().layout.window / s.fs, s.codes, c, l);
   EXPECT_LE(s.measurement_rate_hz(), v + 1e-9);
   EXPECT_GT(s.measurement_rate_hz(), s.fs / (s.fs / v + 1));
-  EXPECT_EQ(s.clk_div, 9);
-  EXPECT_EQ(s.baud_div, 30);
+  // hardware.clock_hz 30 MHz: 6 clocks per 5 MS/s sample, 20 per 1.5 Mbaud bit.
+  EXPECT_EQ(s.clk_div, 6);
+  EXPECT_EQ(s.baud_div, 20);
 }
 
 TEST(HwSystem, DriveIsTheScheduleOfHbridgeBursts) {
@@ -103,3 +104,45 @@ TEST(HwSystem, RefusesClocksThatAreNotMultiplesOfTheSampleRate) {
 // is what the generator writes.)
 
 }  // namespace
+
+TEST(HwSystem, Ice40PllMatchesIcepll) {
+  // What `icepll -i 12 -o 30` and `icepll -i 12 -o 45` print (icestorm's own search).
+  const Ice40Pll p30 = ice40_pll(12e6, 30e6);
+  EXPECT_EQ(p30.divr, 0);
+  EXPECT_EQ(p30.divf, 79);
+  EXPECT_EQ(p30.divq, 5);
+  EXPECT_EQ(p30.filter_range, 1);
+  EXPECT_DOUBLE_EQ(p30.f_vco, 960e6);
+  const Ice40Pll p45 = ice40_pll(12e6, 45e6);
+  EXPECT_EQ(p45.divf, 59);
+  EXPECT_EQ(p45.divq, 4);
+  // 47 MHz is not exact from 12 MHz (F_PFD >= 10 MHz leaves DIVR = 0 and 47 * 2^q / 12 is
+  // never an integer in the VCO range).
+  try {
+    ice40_pll(12e6, 47e6);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("clk_hz"), std::string::npos) << e.what();
+  }
+}
+
+TEST(HwSystem, ClockComesFromTheConfigurationAndReachesTheBoardFiles) {
+  const ReceiverDesign d = design();
+  const SystemDesign s = system_design(d);
+  EXPECT_EQ(s.clk_hz, d.config.clock_hz);
+  EXPECT_EQ(s.clk_div, d.config.sample_cycles());
+  const auto files = generate_system_files(d, "test");
+  const std::string& vh = files.at("rtl/ice40_pll.vh");
+  const Ice40Pll p = ice40_pll(12e6, d.config.clock_hz);
+  EXPECT_NE(vh.find("`define RANGING_PLL_DIVF " + std::to_string(p.divf) + "\n"), std::string::npos) << vh;
+  EXPECT_NE(vh.find("`define RANGING_PLL_DIVQ " + std::to_string(p.divq) + "\n"), std::string::npos) << vh;
+  // A configuration clock that is not a multiple of fs is refused by the configuration itself.
+  ReceiverConfig c = d.config;
+  c.clock_hz = 31e6;
+  try {
+    validate(c);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("hardware.clock_hz"), std::string::npos) << e.what();
+  }
+}

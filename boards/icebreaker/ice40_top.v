@@ -5,13 +5,15 @@
 // Project:   ranging -- coded ultrasonic ranging system
 //
 // Purpose:   iCEBreaker (iCE40UP5K-SG48) top: PLL from the 12 MHz oscillator to
-//            the 45 MHz system clock, reset, and the generated
+//            the system clock (hardware.clock_hz), reset, and the generated
 //            ranging_system_top (rtl/ranging_system.v) on the board's pins
 //            (boards/icebreaker/icebreaker.pcf, docs/bitstream.md).
 //
-// Clock:     `icepll -i 12 -o 45`: DIVR = 0, DIVF = 59, DIVQ = 4, FILTER_RANGE = 1
-//            -> F_PFD = 12 MHz, F_VCO = 720 MHz, F_PLLOUT = 45.000 MHz (exact).
-//            45 MHz = 9 x 5 MS/s (CLK_DIV 9) = 30 x 1.5 Mbaud (BAUD_DIV 30).
+// Clock:     the PLL settings come from the generated rtl/ice40_pll.vh
+//            (`ranging generate`, model/hw_system.cpp: ice40_pll, the same search
+//            as `icepll -i 12 -o <MHz>`); the default 30 MHz is DIVR 0, DIVF 79,
+//            DIVQ 5, FILTER_RANGE 1: F_PFD 12 MHz, F_VCO 960 MHz, exact,
+//            = 6 x 5 MS/s (CLK_DIV 6) = 20 x 1.5 Mbaud (BAUD_DIV 20).
 //            SB_PLL40_PAD: the oscillator is on pin 35, a PLL input pad.
 //
 // Reset:     held while the PLL is not locked or BTN_N is pressed, then 16
@@ -36,13 +38,15 @@ module ice40_top (
 );
   wire clk, locked;
 
+`include "ice40_pll.vh"
+
 `ifdef SYNTHESIS
   SB_PLL40_PAD #(
     .FEEDBACK_PATH("SIMPLE"),
-    .DIVR(4'b0000),         // DIVR =  0
-    .DIVF(7'b0111011),      // DIVF = 59
-    .DIVQ(3'b100),          // DIVQ =  4
-    .FILTER_RANGE(3'b001)   // FILTER_RANGE = 1
+    .DIVR(`RANGING_PLL_DIVR),
+    .DIVF(`RANGING_PLL_DIVF),
+    .DIVQ(`RANGING_PLL_DIVQ),
+    .FILTER_RANGE(`RANGING_PLL_FILTER_RANGE)
   ) u_pll (
     .LOCK(locked),
     .RESETB(1'b1),

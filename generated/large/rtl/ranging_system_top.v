@@ -2,7 +2,7 @@
 // change the configuration and regenerate (docs/bitstream.md).
 //
 // ranging_system_top: rtl/ranging_system.v with the parameters of this configuration.
-// fs = 5e+06 S/s = clk 4.5e+07 Hz / 9; burst period T = 1686 samples (2965.6 measurements/s); speed of sound 340 m/s; UART 1.5e+06 baud.
+// fs = 5e+06 S/s = clk 9e+07 Hz / 18; burst period T = 1686 samples (2965.6 measurements/s); speed of sound 340 m/s; UART 1.5e+06 baud.
 `default_nettype none
 
 module ranging_system_top (
@@ -16,7 +16,7 @@ module ranging_system_top (
   output wire sample_tick, meas_valid
 );
   ranging_system #(
-    .CLK_DIV(32'd9),
+    .CLK_DIV(32'd18),
     .ADC_W(32'd12),
     .ADC_OFFSET_BINARY(32'd1),
     .CODES(32'd9),
@@ -33,8 +33,8 @@ module ranging_system_top (
     .OFFSETS(288'h000462c3000462c80004630500046286000462c10004631a000462f100046298000462c5),
     .C_FRAC(32'd16),
     .C_INIT(32'd4456448),
-    .BAUD_DIV(32'd30),
-    .LED_HOLD(32'd2250000)
+    .BAUD_DIV(32'd60),
+    .LED_HOLD(32'd4500000)
   ) u_system (
     .clk(clk), .rst(rst), .adc_clk(adc_clk), .adc_data(adc_data),
     .hb_p(hb_p), .hb_n(hb_n), .tx_active(tx_active), .c_wr(c_wr), .c_value(c_value),
