@@ -6,7 +6,7 @@
 //
 // Purpose:   UART transmitter, 8N1 (start bit 0, 8 data bits LSB first, one
 //            stop bit 1), BAUD_DIV system clocks per bit (f_clk / baud, integer:
-//            45 MHz / 1.5 Mbaud = 30). Line idles high.
+//            30 MHz / 1.5 Mbaud = 20 by default). Line idles high.
 //
 // Stream:    s_valid/s_ready byte input; s_ready is high when idle; a byte takes
 //            10 BAUD_DIV clocks.
