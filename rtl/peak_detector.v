@@ -222,7 +222,18 @@ module peak_detector #(
   localparam signed [ARR_W-1:0] DECIM_A = {{(ARR_W-32){1'b0}}, DECIM_I[31:0]};
   wire signed [FR_W-1:0] frac = ev_neg ? -$signed(fmag) : $signed(fmag);
   wire signed [ARR_W-1:0] frac_x = {{(ARR_W-FR_W){frac[FR_W-1]}}, frac};
-  wire signed [ARR_W-1:0] arrival = $signed({1'b0, c_n, {FRAC_W{1'b0}}}) + frac_x * DECIM_A;
+  // DECIM * frac as shifts and adds of the constant's set bits (no multiplier cell)
+  function [ARR_W-1:0] times_decim;
+    input [ARR_W-1:0] v;
+    integer b;
+    begin
+      times_decim = {ARR_W{1'b0}};
+      for (b = 0; b < 31; b = b + 1)
+        if (DECIM_A[b]) times_decim = times_decim + (v << b);
+    end
+  endfunction
+  wire [ARR_W-1:0] frac_d = times_decim(frac_x);
+  wire signed [ARR_W-1:0] arrival = $signed({1'b0, c_n, {FRAC_W{1'b0}}}) + $signed(frac_d);
 
   assign s_ready = (state == S_IDLE);
 

@@ -3,13 +3,23 @@
 // random s_valid gaps, random m_ready back-pressure and a reset in the middle of a stream;
 // every event (code, arrival, score, margin) must equal the model's, none lost or duplicated
 // (the model's flush() at the end of a stream is not part of the hardware and not compared).
-// Also the Verilator lint (-Wall). RANGING_TRACE=1 writes $RANGING_TRACE_DIR/tb_peak_detector.fst.
+// A paced run at the default configuration presents one beat every DECIM x 6 clocks (the bank's
+// rate) with m_ready = 1 and asserts the detector is ready for every beat (it never stalls the
+// bank) while the events still match the model. Synthetic beats drive the divider and the
+// cross-product comparison to their edges (score exactly at / just below the cap, fraction
+// exactly +-1/2, zero and negative parabola denominators, equal rho^2, 48-bit operands); their
+// expected events come from a step-by-step reference of PeakDetectorFixed::execute built on the
+// model's correlation_score and parabolic_fraction, itself checked equal to the model on the
+// coded streams. Also the Verilator lint (-Wall). RANGING_TRACE=1 writes $RANGING_TRACE_DIR/tb_peak_detector.fst.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <algorithm>
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -258,6 +268,301 @@ TEST(PeakDetectorRtl, EventsBitExactUnderGapsBackPressureAndReset) {
               static_cast<unsigned long long>(tot.events), static_cast<unsigned long long>(tot.mismatches));
   EXPECT_EQ(tot.mismatches, 0u) << tot.first;
   EXPECT_GT(tot.events, 50u);
+}
+
+// PeakDetectorFixed::execute on raw beats (the model takes a bank object, whose state cannot be
+// set to synthetic values): the same rules, with the model's score and fraction functions.
+class RefDetector {
+ public:
+  RefDetector() {
+    const auto& d = design();
+    CorrelatorBankFixed bank(d.reference, d.config.correlator);
+    PeakDetectorFixed det(d.config.detector, bank.layout(), d.config.correlator);
+    thr_ = det.threshold_q();
+    min_norm_ = det.min_norm_q();
+    holdoff_ = det.holdoff();
+    shift_ = d.layout.energy_shift;
+    score_bits_ = d.config.correlator.score_bits;
+    frac_bits_ = d.config.detector.frac_bits;
+    decim_ = d.layout.decimation;
+  }
+  std::optional<EventFixed> execute(const Beat& b) {
+    const auto& q = b.q;
+    if (prev_.empty()) prev_.assign(q.size(), 0);
+    int best = 0;
+    for (int j = 1; j < static_cast<int>(q.size()); ++j)
+      if (q[j] > q[best]) best = j;
+    std::uint64_t second = 0;
+    for (int j = 0; j < static_cast<int>(q.size()); ++j)
+      if (j != best && q[j] > second) second = q[j];
+    if (cand_ && !cand_->has_next) {
+      cand_->qn = q[cand_->code];
+      cand_->has_next = true;
+    }
+    const std::uint64_t norm = b.energy >> shift_, norm1 = std::max<std::uint64_t>(norm, 1);
+    const bool gate = static_cast<uint128_t>(q[best]) >= static_cast<uint128_t>(thr_) * norm1 && norm >= min_norm_;
+    const bool better = !cand_ || static_cast<uint128_t>(q[best]) * std::max<std::uint64_t>(cand_->norm, 1) >
+                                      static_cast<uint128_t>(cand_->q) * norm1;
+    std::optional<EventFixed> out;
+    const auto n = static_cast<std::int64_t>(b.index);
+    if (gate && better) {
+      cand_ = Cand{n, best, prev_[best], q[best], 0, second, norm, false};
+    } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
+      EventFixed e;
+      e.code = cand_->code + 1;
+      const std::int64_t frac = parabolic_fraction(cand_->qp, cand_->q, cand_->qn, frac_bits_);
+      fractions.push_back(frac);
+      den_not_positive.push_back(2 * static_cast<int128_t>(cand_->q) <=
+                                 static_cast<int128_t>(cand_->qp) + cand_->qn);
+      e.arrival = cand_->n * (std::int64_t{1} << frac_bits_) + decim_ * frac;
+      e.score = correlation_score(cand_->q, cand_->norm, score_bits_);
+      e.margin = e.score - correlation_score(cand_->q2, cand_->norm, score_bits_);
+      out = e;
+      cand_.reset();
+    }
+    prev_ = q;
+    return out;
+  }
+  int holdoff() const { return holdoff_; }
+  std::uint64_t threshold() const { return thr_; }
+  std::uint64_t min_norm() const { return min_norm_; }
+  std::vector<std::int64_t> fractions;  // of every event, and whether its denominator was <= 0
+  std::vector<bool> den_not_positive;
+
+ private:
+  struct Cand {
+    std::int64_t n;
+    int code;
+    std::uint64_t qp, q, qn, q2, norm;
+    bool has_next;
+  };
+  std::uint64_t thr_ = 0, min_norm_ = 0;
+  int holdoff_ = 0, shift_ = 0, score_bits_ = 0, frac_bits_ = 0, decim_ = 0;
+  std::vector<std::uint64_t> prev_;
+  std::optional<Cand> cand_;
+};
+
+struct PacedResult {
+  std::uint64_t stalls = 0, mismatches = 0, events = 0, max_busy = 0, max_busy_event = 0;
+  std::string first;
+};
+
+// One beat every `period` clocks (or back to back when 0), m_ready = 1. A stall is a presented
+// beat that is not accepted on its first clock. Busy: clocks from a beat's acceptance until
+// s_ready is high again.
+PacedResult run_paced(DetSim& sim, const std::vector<Beat>& beats, const std::vector<EventFixed>& expected,
+                      std::uint64_t period) {
+  const auto& d = design();
+  const int ww = d.layout.weighted_bits, fb = d.config.detector.frac_bits;
+  PacedResult r;
+  auto fail = [&](const std::string& m) {
+    ++r.mismatches;
+    if (r.first.empty()) r.first = m;
+  };
+  sim.reset();
+  std::size_t in = 0, got = 0;
+  std::uint64_t cycle = 0, due = 0, accepted_at = 0, busy_start_events = 0;
+  bool busy = false, first_clock = true;
+  while ((in < beats.size() || busy) && cycle < (beats.size() + 10) * (period + 400)) {
+    auto& t = sim.top();
+    const bool present = in < beats.size() && cycle >= due;
+    t.s_valid = present ? 1 : 0;
+    if (present) {
+      for (std::size_t j = 0; j < beats[in].q.size(); ++j)
+        set_bits(t.s_weighted, static_cast<int>(j) * ww, ww, beats[in].q[j]);
+      t.s_energy = beats[in].energy;
+      t.s_index = beats[in].index;
+    }
+    t.m_ready = 1;
+    t.eval();
+    if (t.m_valid) {
+      EventFixed g;
+      g.code = t.m_code;
+      g.arrival = sext(t.m_arrival, 40 + fb + 1);
+      g.score = t.m_score;
+      g.margin = t.m_margin;
+      if (got >= expected.size()) {
+        fail("extra event");
+      } else if (!(g == expected[got])) {
+        const auto& e = expected[got];
+        std::ostringstream os;
+        os << "event " << got << ": expected {code " << e.code << ", arrival " << e.arrival << ", score "
+           << e.score << ", margin " << e.margin << "} rtl {code " << g.code << ", arrival " << g.arrival
+           << ", score " << g.score << ", margin " << g.margin << "}";
+        fail(os.str());
+      }
+      ++got;
+    }
+    if (busy && t.s_ready) {  // the event (if any) leaves on the clock s_ready rises
+      const std::uint64_t b = cycle - accepted_at;
+      r.max_busy = std::max(r.max_busy, b);
+      if (got > busy_start_events) r.max_busy_event = std::max(r.max_busy_event, b);
+      busy = false;
+    }
+    if (present) {
+      if (first_clock && !t.s_ready) ++r.stalls;
+      first_clock = false;
+      if (t.s_ready) {
+        ++in;
+        busy = true;
+        accepted_at = cycle;
+        busy_start_events = got;
+        due = period ? due + period : cycle + 1;
+        first_clock = true;
+      }
+    }
+    sim.tick();
+    ++cycle;
+  }
+  for (int i = 0; i < 400; ++i) {  // drain: the last beat's event, nothing else
+    sim.top().s_valid = 0;
+    sim.top().m_ready = 1;
+    sim.top().eval();
+    if (sim.top().m_valid) {
+      if (got >= expected.size()) fail("extra event after the last beat");
+      ++got;
+    }
+    sim.tick();
+  }
+  if (got != expected.size()) fail(std::to_string(got) + " of " + std::to_string(expected.size()) + " events");
+  r.events = got;
+  return r;
+}
+
+TEST(PeakDetectorRtl, PacedAtTheBankRateNeverStallsAndStaysBitExact) {
+  const auto& d = design();
+  const std::uint64_t period = static_cast<std::uint64_t>(d.layout.decimation) * 6;  // 5 MS/s at 30 MHz
+  std::vector<Beat> beats;
+  std::vector<EventFixed> events;
+  std::size_t before = 0;
+  const auto y = burst_stream(300, 0.003, 36);
+  model(y, SIZE_MAX, beats, events, before);
+  // The step-by-step reference used for the synthetic cases equals the model here.
+  RefDetector ref;
+  std::vector<EventFixed> ref_events;
+  for (const auto& b : beats)
+    if (auto e = ref.execute(b)) ref_events.push_back(*e);
+  EXPECT_EQ(ref_events, events);
+  DetSim sim;
+  const auto r = run_paced(sim, beats, events, period);
+  std::printf("peak_detector paced: %zu beats, one every %llu clocks, %llu events, %llu stalls; "
+              "max clocks busy per beat %llu, per beat with an event %llu\n",
+              beats.size(), static_cast<unsigned long long>(period), static_cast<unsigned long long>(r.events),
+              static_cast<unsigned long long>(r.stalls), static_cast<unsigned long long>(r.max_busy),
+              static_cast<unsigned long long>(r.max_busy_event));
+  EXPECT_EQ(r.mismatches, 0u) << r.first;
+  EXPECT_EQ(r.stalls, 0u);
+  EXPECT_GT(r.events, 30u);
+  EXPECT_GT(r.max_busy_event, 0u);
+  EXPECT_LE(r.max_busy_event, period);
+}
+
+TEST(PeakDetectorRtl, DividerAndCrossProductEdgeCases) {
+  const auto& d = design();
+  const int codes = static_cast<int>(d.family.codes.size());
+  const int ww = d.layout.weighted_bits, shift = d.layout.energy_shift;
+  const int sb = d.config.correlator.score_bits, fb = d.config.detector.frac_bits;
+  const std::uint64_t qmax = (ww >= 64) ? ~std::uint64_t{0} : (std::uint64_t{1} << ww) - 1;
+  const int norm_bits = d.layout.energy_bits - shift;
+  const std::uint64_t nmax = (std::uint64_t{1} << std::min(norm_bits, 40)) - 1;
+  const std::uint64_t cap = (std::uint64_t{1} << sb) - 1;
+  const std::int64_t half = std::int64_t{1} << (fb - 1);
+  RefDetector ref;
+  ASSERT_GE(nmax, ref.min_norm());
+  std::mt19937_64 rng(4242);
+  std::vector<Beat> beats;
+  std::uint64_t n = 5000;
+  const std::uint64_t step = static_cast<std::uint64_t>(d.layout.decimation);
+  auto beat = [&](int code, std::uint64_t qc, int code2, std::uint64_t q2, std::uint64_t norm) {
+    Beat b;
+    b.q.assign(static_cast<std::size_t>(codes), 0);
+    for (auto& v : b.q) v = rng() % 1000;
+    b.q[static_cast<std::size_t>(code2)] = q2;
+    b.q[static_cast<std::size_t>(code)] = qc;
+    b.energy = (norm << shift) | (rng() & ((std::uint64_t{1} << shift) - 1));
+    b.index = n;
+    n += step;
+    beats.push_back(b);
+  };
+  // A peak (qp, q, qn) of code c with norm nb, second code q2, then quiet beats past the holdoff.
+  auto peak = [&](std::uint64_t qp, std::uint64_t q, std::uint64_t qn, std::uint64_t q2, std::uint64_t nb,
+                  std::uint64_t nc) {
+    const int c = static_cast<int>(rng() % static_cast<std::uint64_t>(codes));
+    const int c2 = (c + 1 + static_cast<int>(rng() % static_cast<std::uint64_t>(codes - 1))) % codes;
+    beat(c, qp, c2, 0, nmax);
+    beat(c, q, c2, q2, nb);
+    beat(c, qn, c2, 0, nc);
+    for (int i = 0; i < ref.holdoff() / static_cast<int>(step) + 3; ++i) beat(c, 0, c2, 0, 1);
+  };
+  const std::uint64_t norms[] = {ref.min_norm(), 12345, nmax};
+  for (std::uint64_t nb : norms) {
+    // score: exactly at the cap, at 2^S (capped), just below; second score at the same edges
+    const std::uint64_t qs[] = {nb * cap + nb - 1, nb * (cap + 1), nb * cap - 1, nb * (cap + 1) - 1};
+    for (std::uint64_t q : qs) {
+      if (q > qmax) continue;
+      peak(q / 2, q, q / 3, q - 1, nb, nmax);
+      peak(q / 2, q, q / 3, nb * cap - 1, nb, nmax);
+      peak(q / 2, q, q / 3, nb * (cap + 1) - 1 <= q ? nb * (cap + 1) - 1 : q / 2, nb, nmax);
+    }
+  }
+  const std::uint64_t big = qmax - 7;
+  // fraction: +1/2 exactly (qn = q), -1/2 (qp = q), zero / negative denominators, 48-bit operands
+  peak(big / 3, big, big, big / 5, norms[2], nmax);
+  peak(big, big, big / 3, big / 5, norms[2], nmax);
+  peak(big, big, big, big / 5, norms[2], nmax);
+  peak(big, big - 1000, big, 5, norms[2], nmax);
+  peak(1000, 1000000, 1000, 5, 30, nmax);
+  // fraction just inside +-1/2: (qn - qp) 2^F = (half - 1/2 ...) x 2 den
+  for (int i = 0; i < 40; ++i) {
+    const std::uint64_t q = (qmax >> 2) + rng() % (qmax >> 2);
+    const std::uint64_t qp = q - 1 - rng() % (q >> 1);
+    const std::uint64_t qn = q - 1 - rng() % 3;
+    peak(qp, q, qn, rng() % q, 1 + rng() % nmax, nmax);
+    peak(qn, q, qp, rng() % q, 1 + rng() % nmax, nmax);
+  }
+  // equal rho^2 (strict >: the earlier candidate stays) and one just better, on wide operands
+  for (int i = 0; i < 10; ++i) {
+    const std::uint64_t nb = 1000 + rng() % (nmax / 4);
+    const std::uint64_t q = std::min<std::uint64_t>(qmax / 4, nb * (cap / 2 + rng() % (cap / 2)));
+    peak(q / 2, q, 2 * q, q / 2, nb, 2 * nb);
+    peak(q / 2, q, 2 * q + 1, q / 2, nb, 2 * nb);
+    peak(q / 2, q, 2 * q - 1, q / 2, nb, 2 * nb);
+  }
+  // random wide values
+  for (int i = 0; i < 150; ++i) {
+    const std::uint64_t q = rng() & qmax;
+    peak(rng() % (q + 1), q, rng() % (q + 1), rng() % (q + 1), 1 + rng() % nmax, 1 + rng() % nmax);
+  }
+  std::vector<EventFixed> expected;
+  for (const auto& b : beats)
+    if (auto e = ref.execute(b)) expected.push_back(*e);
+  int at_cap = 0, below_cap = 0, plus_half = 0, minus_half = 0, den_le0 = 0, inner = 0;
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    at_cap += expected[i].score == cap;
+    below_cap += expected[i].score == cap - 1;
+    const std::int64_t f = ref.fractions[i];
+    plus_half += f == half;
+    minus_half += f == -half;
+    den_le0 += ref.den_not_positive[i] ? 1 : 0;
+    inner += (f == half - 1 || f == 1 - half) ? 1 : 0;
+  }
+  DetSim sim;
+  const auto r = run_paced(sim, beats, expected, 0);
+  std::printf("peak_detector edge cases, back to back: max clocks busy per beat %llu, per beat with an event %llu\n",
+              static_cast<unsigned long long>(r.max_busy), static_cast<unsigned long long>(r.max_busy_event));
+  EXPECT_LE(r.max_busy_event, static_cast<std::uint64_t>(d.layout.decimation) * 6);
+  std::printf("peak_detector edge cases: %zu beats, %zu events (score: %d at the cap, %d at cap - 1; fraction: "
+              "%d at +1/2, %d at -1/2, %d at +-(1/2 - 1 lsb), %d with denominator <= 0), %llu mismatches\n",
+              beats.size(), expected.size(), at_cap, below_cap, plus_half, minus_half, inner, den_le0,
+              static_cast<unsigned long long>(r.mismatches));
+  EXPECT_EQ(r.mismatches, 0u) << r.first;
+  EXPECT_GT(at_cap, 5);
+  EXPECT_GT(below_cap, 3);
+  EXPECT_GT(plus_half, 0);
+  EXPECT_GT(minus_half, 0);
+  EXPECT_GT(den_le0, 1);
+  EXPECT_GT(inner, 0);
+  EXPECT_GT(expected.size(), 200u);
 }
 
 std::string slurp(const std::string& path) {
