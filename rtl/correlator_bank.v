@@ -2,7 +2,7 @@
 // (model/correlator_bank.cpp, docs/architecture.md).
 //
 // What it computes, per full-rate input y[n] (signed DATA_W, DATA_FRAC fraction bits):
-//   B[n]   = q_mix(y[n] * LO_COS[n mod P]), q_mix(-(y[n] * LO_SIN[n mod P]))   (mixer)
+//   B[n]   = q_mix(y[n] * LO_COS[n mod P]), q_mix(y[n] * -LO_SIN[n mod P])   (mixer)
 //   acc    = sum_{i<P} B[n-i]             moving sum over one carrier cycle, DEC_W, exact
 //   E[n]   = sum_{i<WINDOW} y[n-i]^2      running energy, ENERGY_W unsigned, exact
 // and after every DECIM-th input (one output beat):
@@ -11,53 +11,72 @@
 //   C_j[k] = sum_{m<CHIPS} s_j(m) F[k - (CHIPS-1-m) CHIP_STEP]   combiner, exact, per code j
 //   Cq_j   = q_corr(C_j),  P_j = Re(Cq_j)^2 + Im(Cq_j)^2,  Q_j = P_j * WEIGHTS[j]
 // Quantizers q_mix / q_chip / q_corr: round half up (add half an LSB, arithmetic shift right
-// by MIX_SHIFT / CHIP_SHIFT / CORR_SHIFT), then saturate to MIX_W / CHIP_W / CORR_W. They
+// by MIX_SHIFT / CHIP_SHIFT / CORR_SHIFT), then saturate to MIX_W / CHIP_W / CORR_W; each is
+// computed one bit wider than the wider of its input and output (no 64-bit logic). They
 // cannot saturate for in-range data (the model sizes them so) but saturate exactly like it.
+// -LO_SIN is a table negated at elaboration (|LO_SIN| <= 2^(LO_W-1)-1, so it fits), so
+// y * -sin = -(y * sin) exactly, as the model.
 // Every other node is exact (no rounding, no overflow):
-//   y*lo: DATA_W+LO_W;  acc: DEC_W = MIX_W+ceil(log2 P);  g*Bd: TAP_W+DEC_W;  FIR acc: FIR_W;
-//   C: COMB_W = CHIP_W+ceil(log2 CHIPS);  Cq^2: 2 CORR_W;  P: kept in 2*CORR_W bits (the
-//   model's POWER_W = 2 CORR_W-1 is one bit short when Re = Im = -2^(CORR_W-1); it computes in
-//   64 bits, so this module does too);  Q: 2 CORR_W + WEIGHT_W product whose top bits are
-//   provably zero (2^(2 CORR_W-1) (2^WEIGHT_W-1) < 2^WEIGHTED_W): the low WEIGHTED_W are kept;
-//   y^2: 2 DATA_W;  E: ENERGY_W = 2 DATA_W-1+ceil(log2 WINDOW) (E + y^2 is formed in one
-//   expression with E - y_old^2, never stored above the bound).
+//   y*lo: DATA_W+LO_W;  acc: DEC_W = MIX_W+ceil(log2 P);  FIR acc: FIR_W (the model's bound of
+//   sum |g||Bd|, so every partial sum fits too);  C: COMB_W = CHIP_W+ceil(log2 CHIPS);
+//   P: 2 CORR_W bits unsigned (holds 2^(2 CORR_W-1));  Q: the low WEIGHTED_W bits of the
+//   2 CORR_W + WEIGHT_W product (its top bits are provably zero);  y^2: 2 DATA_W;
+//   E: ENERGY_W = 2 DATA_W-1+ceil(log2 WINDOW) (E + y^2 <= (WINDOW+1) 2^(2 DATA_W-2) fits,
+//   so E is updated in two steps, + y^2 then - y_old^2).
 //
-// Architecture (two decoupled engines and a one-entry handoff register):
-//   front end: one multiplier (DATA_W x max(LO_W,DATA_W), registered operands and product)
-//     does y*cos, y*sin, y*y and y_old*y_old: 6 cycles per input sample (7 at a decimation
-//     point if the back end is still busy with the previous output it waits here).
-//   back end, per decimated output: chip FIR on two lanes (re, im; one tap per cycle),
-//     TAPS + 4 cycles; F quantize/store 1; combiner CHIPS + 2 (reads the shared F taps, updates
-//     all 2*CODES accumulators in parallel with adders); power + weight pipelined over the
-//     codes, CODES + 5 cycles (|Cq|^2 reuses the two FIR lanes; P*w is a third multiplier);
-//     1 cycle to publish. Total about TAPS + CHIPS + CODES + 14 = 111 cycles per output at the
-//     default parameters, overlapped with the front end of the next DECIM samples.
-//   Throughput: max(6 DECIM + 1, TAPS + CHIPS + CODES + 14) / DECIM cycles per input sample =
-//     22.2 at the defaults (needs ~111 MHz for 5 MS/s). To reach the 8-9 cycles/sample target
-//     the FIR needs 4 lanes (e.g. Bd split over 4 EBR banks by address mod 4: 81 taps in 21
-//     cycles per lane pair) and the power/weight loop must overlap the next FIR; that is the
-//     follow-up tuning issue. Latency: last input of a decimation group to m_valid =
-//     ~1 + TAPS + CHIPS + CODES + 14 cycles.
-//   Multipliers (plain signed/unsigned `*`, registered operands, registered product, so
-//   synth_ice40 -dsp can map them): front 16x16 (1 SB_MAC16); FIR lanes max(DEC_W,CORR_W) x
-//   max(TAP_W,CORR_W) = 23x16 (wider than 16x16: Yosys mul2dsp splits each into 2 SB_MAC16);
-//   weight 2 CORR_W x WEIGHT_W = 32x16 unsigned (split, 2-3 SB_MAC16). As written ~7 SB_MAC16:
-//   with the bandpass's 5 this exceeds the UP5K's 8; fitting needs the Bd word cut to 16 bits
-//   (or the FIR lanes in LUT shift-add) and P*w on a 16x16 DSP in two passes.
-//   Memories (synchronous read, no reset, inferable as EBR): B history PERIOD x 2 MIX_W,
-//   y history WINDOW x DATA_W (y, not y^2: y_old^2 is recomputed), Bd history TAPS x 2 DEC_W,
-//   F history ((CHIPS-1) CHIP_STEP + 1) x 2 CHIP_W. Histories are cleared lazily: a fill
-//   flag/counter per history masks entries not written since reset to zero, so after reset
-//   the outputs equal a fresh model's without a clearing pass.
+// Architecture: a front end and a back end with three engines sharing one multiplier.
+//   Front end (6 clocks per input sample): one signed DATA_W x max(LO_W,DATA_W) multiplier
+//     (registered operands and product) does y*cos, y*-sin, y*y and y_old*y_old; the B and y
+//     histories are memories. At a decimation point the same cycle writes Bd = acc into the
+//     Bd history and pushes E into a 2-entry queue (a hand-off costs no extra cycle unless
+//     the back end is more than one output behind; then the front end waits).
+//   Back end: ONE unsigned 16x16 multiplier (registered limb operands, registered product)
+//     in sign-magnitude: every wide operand is split into 16-bit limbs of its magnitude, the
+//     limb product is shifted by 16 (la+lb) and added or subtracted. Exact integer arithmetic,
+//     so the order of the partial products does not change any result. Three clients, in
+//     priority order W > SQ > FIR, each issuing one limb product per clock:
+//     FIR (stage A): per output, lane re then lane im, TAPS taps, ceil(DEC_W/16) x
+//       ceil(TAP_W/16) limb products per tap, from the Bd history (TAPS+1 deep, so the next
+//       Bd can be written while a FIR runs) into one FIR_W accumulator; F_re is quantized
+//       while the first im product is accumulated, F_im after the last.
+//     Combiner (no multiplier): per output, rounds of two codes; each round reads the CHIPS
+//       taps F[k - (CHIPS-1-m) CHIP_STEP] from the F history (one per clock) into four
+//       COMB_W accumulators (re, im of both codes), then quantizes them into Cq registers
+//       (and the m_corr outputs): CHIPS + 2 clocks per round.
+//     SQ: Re^2 + Im^2 per code (2 ceil(CORR_W/16)^2 limb products) into P.
+//     W: P * w_j (ceil(2 CORR_W/16) x ceil(WEIGHT_W/16) limb products), written straight
+//       into code j's slot of m_weighted.
+//     The FIR of output k+1 runs in the clocks the SQ/W engines of output k leave free.
+//   Limb products per output at the defaults (DEC_W 23, TAP_W 16, CORR_W 16, TAPS 20,
+//     CODES 9): FIR 2*20*2 = 80, SQ 9*2 = 18, W 9*2 = 18: 116 <= 120 = 6 DECIM clocks.
+// Throughput: 6 clocks per input sample when the back end keeps up, i.e. when
+//   2 TAPS ceil(DEC_W/16) ceil(TAP_W/16) + CODES (2 ceil(CORR_W/16)^2 + ceil(2 CORR_W/16)
+//   ceil(WEIGHT_W/16)) <= 6 DECIM (plus a few clocks of pipeline slack); otherwise the back
+//   end sets the pace (the front end waits at a decimation point). 6 clocks at the defaults
+//   (tested: one input every 6 clocks is never refused).
+// Latency: last input of a decimation group to m_valid: about 2 TAPS ceil(DEC_W/16)
+//   ceil(TAP_W/16) + 4 (FIR) + (CHIPS+2) ceil(CODES/2) + 8 clocks when idle (~150 at the
+//   defaults), more when the previous output's SQ/W work overlaps.
+// Multipliers (synth_ice40 -dsp): 2 SB_MAC16 at the defaults (front 16x16 signed, back 16x16
+//   unsigned). Memories (synchronous read, no reset, EBR): B history PERIOD x 2 MIX_W,
+//   y history WINDOW x DATA_W (y, not y^2: y_old^2 is recomputed), Bd history (TAPS+1) x
+//   2 DEC_W, F history ((CHIPS-1) CHIP_STEP + 1) x 2 CHIP_W. Histories are cleared lazily:
+//   a fill flag/counter per history masks entries not written since reset to zero, so after
+//   reset the outputs equal a fresh model's without a clearing pass.
+// Resources (yosys synth_ice40 -dsp, defaults, /work/notes/module_stat.sh correlator_bank):
+//   see the commit message of the last change to this file; the parallel m_weighted
+//   (CODES x WEIGHTED_W) and the m_corr_re/im debug registers (2 CODES CORR_W) are the
+//   largest DFF groups.
 //
 // Streams: s_* one beat per input sample (s_ready high only when the front end is idle);
 // m_* one beat per decimated output; data stable while m_valid && !m_ready; the back end
-// waits (and the front end then stalls) while the output is not taken: no output is lost.
+// does not start an output's combiner while the previous output is not taken (the FIR of the
+// next output may run; then the front end waits): no output is lost.
 // Reset: synchronous, active high; clears every register, counter, phase and fill flag.
 `default_nettype none
 
-// DATA_FRAC, MIX_FRAC and POWER_W are part of the documented interface (formats of the
-// streams) but the arithmetic only needs the shifts and widths derived from them.
+// DATA_FRAC, MIX_FRAC, COMB_W and POWER_W are part of the documented interface (formats of
+// the streams) but the arithmetic only needs the shifts and widths derived from them.
 /* verilator lint_off UNUSEDPARAM */
 module correlator_bank #(
   parameter integer DATA_W = 16, DATA_FRAC = 14,
@@ -93,61 +112,63 @@ module correlator_bank #(
   output wire [CODES*CORR_W-1:0]     m_corr_re, m_corr_im
 );
   // ---------------------------------------------------------------- helpers
-  function integer clog2;
-    input integer v;
-    integer r;
-    begin
-      r = 0;
-      while ((1 << r) < v) r = r + 1;
-      clog2 = (r < 1) ? 1 : r;
-    end
-  endfunction
   function integer imax;
     input integer a, b;
     begin
       imax = (a > b) ? a : b;
     end
   endfunction
-
-  // Round half up by `shift`, then saturate to `outw` bits (signed). Computed in QW bits,
-  // wide enough for every node (the model limits FIR_W to 63).
-  localparam integer QW = 72;
-  function [QW-1:0] rnd_sat;
-    input [QW-1:0] x;  // sign-extended value
-    input integer shift, outw;
-    reg signed [QW-1:0] t, mx, mn, one;
+  function integer wbits;  // width of a counter/index holding 0..v-1 (at least 1)
+    input integer v;
     begin
-      one = {{(QW-1){1'b0}}, 1'b1};
-      t = x;
-      if (shift > 0) t = (t + (one <<< (shift - 1))) >>> shift;
-      mx = (one <<< (outw - 1)) - one;
-      mn = -mx - one;
-      if (t > mx) t = mx;
-      else if (t < mn) t = mn;
-      rnd_sat = t;
+      wbits = (v <= 2) ? 1 : $clog2(v);
+    end
+  endfunction
+  function integer nlimbs;  // 16-bit limbs of a w-bit unsigned magnitude
+    input integer w;
+    begin
+      nlimbs = (w + 15) / 16;
     end
   endfunction
 
+  localparam integer LW      = 16;                          // back-end limb width
   localparam integer FN      = (CHIPS - 1) * CHIP_STEP + 1;  // F history depth
-  localparam integer PA_W    = clog2(PERIOD);
-  localparam integer YA_W    = clog2(WINDOW);
-  localparam integer BA_W    = clog2(TAPS);
-  localparam integer FA_W    = clog2(FN);
+  localparam integer BDN     = TAPS + 1;                    // Bd history depth
+  localparam integer PA_W    = wbits(PERIOD);
+  localparam integer YA_W    = wbits(WINDOW);
+  localparam integer BA_W    = wbits(BDN);
+  localparam integer FA_W    = wbits(FN);
   localparam integer FB_W    = imax(LO_W, DATA_W);
   localparam integer FP_W    = DATA_W + FB_W;               // front-end product
-  localparam integer MA_W    = imax(DEC_W, CORR_W);         // lane operand a (Bd | Cq)
-  localparam integer MB_W    = imax(TAP_W, CORR_W);         // lane operand b (g | Cq)
-  localparam integer LP_W    = MA_W + MB_W;                 // lane product
-  localparam integer FACC_W  = imax(FIR_W, LP_W);
+  localparam integer DP_W    = wbits(DECIM);
+  localparam integer EX_W    = imax(ENERGY_W, FP_W) + 1;    // energy update width
   localparam integer CA_W    = (CHIPS == 1) ? CHIP_W + 1 : COMB_W;  // -F must fit
-  localparam integer PW_W    = 2 * CORR_W;                  // exact |Cq|^2
-  localparam integer WP_W    = PW_W + WEIGHT_W;             // P*w product
-  localparam integer TI_W    = clog2(TAPS + 1);
-  localparam integer CI_W    = clog2(CHIPS + 1);
-  localparam integer JI_W    = clog2(CODES + 1);
-  localparam integer DP_W    = clog2(DECIM);
-  localparam integer DIST_W  = clog2(FN + 1);
-  localparam integer EX_W    = imax(ENERGY_W, FP_W);        // energy update width
+  localparam integer PW_W    = 2 * CORR_W;                  // exact |Cq|^2 sum
+  // limb counts
+  localparam integer NBA     = nlimbs(DEC_W);               // |Bd| <= 2^(DEC_W-1)
+  localparam integer NTB     = nlimbs(TAP_W);
+  localparam integer NC      = nlimbs(CORR_W);
+  localparam integer NP      = nlimbs(PW_W);
+  localparam integer NW      = nlimbs(WEIGHT_W);
+  localparam integer NWOP    = NP * NW;                     // W limb products per code
+  localparam integer SHMAX   = imax(imax(NBA + NTB - 2, 2 * NC - 2), NP + NW - 2);
+  localparam integer SH_W    = wbits(SHMAX + 1);
+  localparam integer XW      = imax(imax(FIR_W, PW_W), imax(WEIGHTED_W, 2 * LW)) + 1;
+  localparam integer TAPM_W  = NTB * LW;
+  localparam integer WTP_W   = NW * LW;
+  localparam integer ROUNDS  = (CODES + 1) / 2;
+  // index widths
+  localparam integer TI_W    = wbits(TAPS + 1);
+  localparam integer CI_W    = wbits(CHIPS);
+  localparam integer JI_W    = wbits(CODES + 1);
+  localparam integer RI_W    = wbits(ROUNDS);
+  localparam integer DIST_W  = wbits(FN + 1);
+  localparam integer LBA_W   = wbits(NBA);
+  localparam integer LTB_W   = wbits(NTB);
+  localparam integer LC_W    = wbits(NC);
+  localparam integer LP_W    = wbits(NP);
+  localparam integer LWT_W   = wbits(NW);
+
   // Sized constants (keep every comparison at its operand's width).
   localparam integer P_LAST_I = PERIOD - 1;
   localparam [PA_W-1:0] P_LAST = P_LAST_I[PA_W-1:0];
@@ -155,10 +176,12 @@ module correlator_bank #(
   localparam [YA_W-1:0] Y_LAST = Y_LAST_I[YA_W-1:0];
   localparam integer D_LAST_I = DECIM - 1;
   localparam [DP_W-1:0] D_LAST = D_LAST_I[DP_W-1:0];
-  localparam integer BD_LAST_I = TAPS - 1;
+  localparam integer BD_LAST_I = BDN - 1;
   localparam [BA_W-1:0] BD_LAST = BD_LAST_I[BA_W-1:0];
   localparam integer TAPS_N_I = TAPS;
   localparam [TI_W-1:0] TAPS_N = TAPS_N_I[TI_W-1:0];
+  localparam integer T_LAST_I = TAPS - 1;
+  localparam [TI_W-1:0] T_LAST = T_LAST_I[TI_W-1:0];
   localparam integer F_LAST_I = FN - 1;
   localparam [FA_W-1:0] F_LAST = F_LAST_I[FA_W-1:0];
   localparam integer FN_N_I = FN;
@@ -167,38 +190,186 @@ module correlator_bank #(
   localparam [DIST_W-1:0] DIST0 = DIST0_I[DIST_W-1:0];
   localparam integer STEP_D_I = CHIP_STEP;
   localparam [DIST_W-1:0] STEP_D = STEP_D_I[DIST_W-1:0];
-  localparam integer STEP_A_I = CHIP_STEP;
-  localparam [FA_W:0] STEP_A = STEP_A_I[FA_W:0];
-  localparam integer FN_A_I = FN;
-  localparam [FA_W:0] FN_A = FN_A_I[FA_W:0];
-  localparam integer CHIPS_N_I = CHIPS;
-  localparam [CI_W-1:0] CHIPS_N = CHIPS_N_I[CI_W-1:0];
-  localparam integer CODES_N_I = CODES;
-  localparam [JI_W-1:0] CODES_N = CODES_N_I[JI_W-1:0];
+  localparam [FA_W:0] STEP_A = STEP_D_I[FA_W:0];
+  localparam [FA_W:0] FN_A = FN_N_I[FA_W:0];
+  localparam integer C_LAST_I = CHIPS - 1;
+  localparam [CI_W-1:0] C_LAST = C_LAST_I[CI_W-1:0];
+  localparam integer R_LAST_I = ROUNDS - 1;
+  localparam [RI_W-1:0] R_LAST = R_LAST_I[RI_W-1:0];
+  localparam integer CODES_I = CODES;
+  localparam [JI_W-1:0] CODES_N = CODES_I[JI_W-1:0];
+  localparam integer NBA_L_I = NBA - 1;
+  localparam [LBA_W-1:0] NBA_L = NBA_L_I[LBA_W-1:0];
+  localparam integer NTB_L_I = NTB - 1;
+  localparam [LTB_W-1:0] NTB_L = NTB_L_I[LTB_W-1:0];
+  localparam integer NC_L_I = NC - 1;
+  localparam [LC_W-1:0] NC_L = NC_L_I[LC_W-1:0];
+  localparam integer NP_L_I = NP - 1;
+  localparam [LP_W-1:0] NP_L = NP_L_I[LP_W-1:0];
+  localparam integer NW_L_I = NW - 1;
+  localparam [LWT_W-1:0] NW_L = NW_L_I[LWT_W-1:0];
+  localparam [SH_W-1:0] SH_ZERO = {SH_W{1'b0}};
+  localparam integer DECIM_I = DECIM;
+  localparam [TIME_W+31:0] DECIM_X = {{TIME_W{1'b0}}, DECIM_I};
+  localparam [TIME_W-1:0] DECIM_T = DECIM_X[TIME_W-1:0];
 
-  // ---------------------------------------------------------------- front end
+  // Elaboration-time tables: |g| per tap (padded to whole limbs), -LO_SIN, padded weights.
+  function [TAPS*TAPM_W-1:0] tap_abs_all;
+    input [TAPS*TAP_W-1:0] v;
+    integer t;
+    reg [TAP_W-1:0] x;
+    begin
+      tap_abs_all = 0;
+      for (t = 0; t < TAPS; t = t + 1) begin
+        x = v[t*TAP_W +: TAP_W];
+        if (x[TAP_W-1]) x = -x;
+        tap_abs_all[t*TAPM_W +: TAP_W] = x;
+      end
+    end
+  endfunction
+  function [PERIOD*FB_W-1:0] lo_neg_all;
+    input [PERIOD*LO_W-1:0] v;
+    integer t;
+    reg [FB_W-1:0] x;
+    begin
+      for (t = 0; t < PERIOD; t = t + 1) begin
+        x = {{(FB_W-LO_W){v[t*LO_W+LO_W-1]}}, v[t*LO_W +: LO_W]};
+        lo_neg_all[t*FB_W +: FB_W] = -x;
+      end
+    end
+  endfunction
+  function [PERIOD*FB_W-1:0] lo_ext_all;
+    input [PERIOD*LO_W-1:0] v;
+    integer t;
+    begin
+      for (t = 0; t < PERIOD; t = t + 1)
+        lo_ext_all[t*FB_W +: FB_W] = {{(FB_W-LO_W){v[t*LO_W+LO_W-1]}}, v[t*LO_W +: LO_W]};
+    end
+  endfunction
+  function [CODES*WTP_W-1:0] wt_pad_all;
+    input [CODES*WEIGHT_W-1:0] v;
+    integer t;
+    begin
+      wt_pad_all = 0;
+      for (t = 0; t < CODES; t = t + 1) wt_pad_all[t*WTP_W +: WEIGHT_W] = v[t*WEIGHT_W +: WEIGHT_W];
+    end
+  endfunction
+  localparam [TAPS*TAPM_W-1:0] TAP_ABS = tap_abs_all(TAP_VALUES);
+  localparam [PERIOD*FB_W-1:0] LO_C = lo_ext_all(LO_COS);
+  localparam [PERIOD*FB_W-1:0] LO_NS = lo_neg_all(LO_SIN);
+  localparam [CODES*WTP_W-1:0] WT_PAD = wt_pad_all(WEIGHTS);
+
+  // Constant tables read with a variable index: written as compare loops so synthesis sees a
+  // small truth table of the index bits instead of a shifter over the whole parameter.
+  function [FB_W-1:0] lo_rom;
+    input [PERIOD*FB_W-1:0] tab;
+    input [PA_W-1:0] i;
+    integer t;
+    begin
+      lo_rom = 0;
+      for (t = 0; t < PERIOD; t = t + 1) if (i == t[PA_W-1:0]) lo_rom = tab[t*FB_W +: FB_W];
+    end
+  endfunction
+  function [TAPM_W:0] tap_rom;  // {sign of g, |g|}
+    input [TI_W-1:0] i;
+    integer t;
+    begin
+      tap_rom = 0;
+      for (t = 0; t < TAPS; t = t + 1)
+        if (i == t[TI_W-1:0]) tap_rom = {TAP_VALUES[t*TAP_W + TAP_W - 1], TAP_ABS[t*TAPM_W +: TAPM_W]};
+    end
+  endfunction
+  function [WTP_W-1:0] wt_rom;
+    input [JI_W-1:0] i;
+    integer t;
+    begin
+      wt_rom = 0;
+      for (t = 0; t < CODES; t = t + 1) if (i == t[JI_W-1:0]) wt_rom = WT_PAD[t*WTP_W +: WTP_W];
+    end
+  endfunction
+  function code_rom;  // chip m of code j is a 1
+    input [JI_W-1:0] j;
+    input [CI_W-1:0] m;
+    integer t, u;
+    begin
+      code_rom = 1'b1;
+      for (t = 0; t < CODES; t = t + 1)
+        for (u = 0; u < CHIPS; u = u + 1)
+          if (j == t[JI_W-1:0] && m == u[CI_W-1:0]) code_rom = CODE_BITS[t*CHIPS + u];
+    end
+  endfunction
+
+  // Quantizers: round half up by SHIFT, saturate to the output width, at real widths.
+  localparam integer QM_W = imax(FP_W, MIX_W) + 1;
+  localparam integer QC_W = imax(FIR_W, CHIP_W) + 1;
+  localparam integer QR_W = imax(CA_W, CORR_W) + 1;
+  localparam [QM_W-1:0] ONE_M = 1;
+  localparam [QC_W-1:0] ONE_C = 1;
+  localparam [QR_W-1:0] ONE_R = 1;
+  localparam [QM_W-1:0] HALF_M = (MIX_SHIFT > 0) ? ONE_M << imax(MIX_SHIFT - 1, 0) : {QM_W{1'b0}};
+  localparam [QC_W-1:0] HALF_C = (CHIP_SHIFT > 0) ? ONE_C << imax(CHIP_SHIFT - 1, 0) : {QC_W{1'b0}};
+  localparam [QR_W-1:0] HALF_R = (CORR_SHIFT > 0) ? ONE_R << imax(CORR_SHIFT - 1, 0) : {QR_W{1'b0}};
+  localparam signed [QM_W-1:0] MAX_M = $signed((ONE_M << (MIX_W - 1)) - ONE_M);
+  localparam signed [QC_W-1:0] MAX_C = $signed((ONE_C << (CHIP_W - 1)) - ONE_C);
+  localparam signed [QR_W-1:0] MAX_R = $signed((ONE_R << (CORR_W - 1)) - ONE_R);
+  localparam signed [QM_W-1:0] MIN_M = -MAX_M - $signed(ONE_M);
+  localparam signed [QC_W-1:0] MIN_C = -MAX_C - $signed(ONE_C);
+  localparam signed [QR_W-1:0] MIN_R = -MAX_R - $signed(ONE_R);
+
+  function [MIX_W-1:0] q_mix;
+    input [FP_W-1:0] x;
+    reg signed [QM_W-1:0] t;
+    begin
+      t = $signed({{(QM_W-FP_W){x[FP_W-1]}}, x} + HALF_M) >>> MIX_SHIFT;
+      if (t > MAX_M) t = MAX_M;
+      else if (t < MIN_M) t = MIN_M;
+      q_mix = t[MIX_W-1:0];
+    end
+  endfunction
+  function [CHIP_W-1:0] q_chip;
+    input [FIR_W-1:0] x;
+    reg signed [QC_W-1:0] t;
+    begin
+      t = $signed({{(QC_W-FIR_W){x[FIR_W-1]}}, x} + HALF_C) >>> CHIP_SHIFT;
+      if (t > MAX_C) t = MAX_C;
+      else if (t < MIN_C) t = MIN_C;
+      q_chip = t[CHIP_W-1:0];
+    end
+  endfunction
+  function [CORR_W-1:0] q_corr;
+    input [CA_W-1:0] x;
+    reg signed [QR_W-1:0] t;
+    begin
+      t = $signed({{(QR_W-CA_W){x[CA_W-1]}}, x} + HALF_R) >>> CORR_SHIFT;
+      if (t > MAX_R) t = MAX_R;
+      else if (t < MIN_R) t = MIN_R;
+      q_corr = t[CORR_W-1:0];
+    end
+  endfunction
+
+  // ================================================================ front end
   localparam [2:0] FE_IDLE = 3'd0, FE_M1 = 3'd1, FE_M2 = 3'd2, FE_M3 = 3'd3,
                    FE_M4 = 3'd4, FE_M5 = 3'd5, FE_HAND = 3'd6;
   reg [2:0] fe_state;
-  reg signed [DATA_W-1:0] y_r, y_old;
+  reg signed [DATA_W-1:0] y_r;
   reg signed [DATA_W-1:0] fa;
   reg signed [FB_W-1:0]   fb;
   reg signed [FP_W-1:0]   fp;
-  reg [FP_W-1:0]          y2_r;
-  reg signed [MIX_W-1:0]  mix_re, mix_im, b_old_re, b_old_im;
+  reg signed [MIX_W-1:0]  mix_re, mix_im;
   reg signed [DEC_W-1:0]  acc_re, acc_im;
   reg [ENERGY_W-1:0]      energy;
   reg [PA_W-1:0]          phase, b_ptr;
   reg                     b_full, y_full;
   reg [YA_W-1:0]          y_ptr;
   reg [DP_W-1:0]          dphase;
-  reg [TIME_W-1:0]        n_cnt;
-  // handoff to the back end
-  reg                     dec_valid;
-  reg signed [DEC_W-1:0]  dec_re, dec_im;
-  reg [ENERGY_W-1:0]      dec_energy;
-  reg [TIME_W-1:0]        dec_index;
-  wire                    dec_take;  // back end takes the handoff this cycle
+  // hand-off: Bd history write pointer/fill, one pending Bd, 2-entry energy queue
+  reg [BA_W-1:0]          bd_wptr;
+  reg [TI_W-1:0]          bd_cnt;
+  reg                     bd_pend;
+  reg [ENERGY_W-1:0]      eq0, eq1;
+  reg [1:0]               eq_n;
+  wire                    e_pop;   // back end takes eq0 (output start)
+  wire                    a_start; // FIR takes the pending Bd
 
   // B history (PERIOD x {re, im}) and y history (WINDOW x y): synchronous-read memories.
   reg [2*MIX_W-1:0] b_mem [0:PERIOD-1];
@@ -214,69 +385,91 @@ module correlator_bank #(
     b_rd <= b_mem[b_ptr];
     y_rd <= y_mem[y_ptr];
   end
+  // Bd history: written by the front end at a hand-off, read by the FIR.
+  reg [2*DEC_W-1:0] bd_mem [0:BDN-1];
+  reg [2*DEC_W-1:0] bd_rd;
+  reg [BA_W-1:0]    a_addr_nx;
+  wire [BA_W-1:0] bd_wptr_next = (bd_wptr == BD_LAST) ? {BA_W{1'b0}} : bd_wptr + 1'b1;
+  wire hand_ok = !bd_pend && (eq_n != 2'd2);
+  wire hand = hand_ok && ((fe_state == FE_M5 && dphase == D_LAST) || fe_state == FE_HAND);
+  always @(posedge clk) begin
+    if (hand) bd_mem[bd_wptr_next] <= {acc_re, acc_im};
+    bd_rd <= bd_mem[a_addr_nx];
+  end
 
   assign s_ready = (fe_state == FE_IDLE);
   wire accept = s_valid && s_ready;
   wire [YA_W-1:0] y_ptr_next = (y_ptr == Y_LAST) ? {YA_W{1'b0}} : y_ptr + 1'b1;
-
-  // Quantized mixer outputs of the two products (im: the negated product, as the model).
-  // Only the low MIX_W / CHIP_W / CORR_W bits of a saturated rnd_sat result are meaningful.
+  wire [MIX_W-1:0] q_mix_fp = q_mix(fp);
+  wire signed [DATA_W-1:0] y_old = y_full ? y_rd : {DATA_W{1'b0}};
+  wire signed [MIX_W-1:0]  b_old_re = b_full ? b_rd[2*MIX_W-1:MIX_W] : {MIX_W{1'b0}};
+  wire signed [MIX_W-1:0]  b_old_im = b_full ? b_rd[MIX_W-1:0] : {MIX_W{1'b0}};
+  // y^2 and y_old^2 are non-negative and below 2^(2 DATA_W-2) + 1.
   /* verilator lint_off UNUSEDSIGNAL */
-  wire [QW-1:0] q_mix_re = rnd_sat({{(QW-FP_W){fp[FP_W-1]}}, fp}, MIX_SHIFT, MIX_W);
+  wire [EX_W-1:0] energy_add = {{(EX_W-ENERGY_W){1'b0}}, energy} + {{(EX_W-FP_W){1'b0}}, fp};
+  wire [EX_W-1:0] energy_sub = {{(EX_W-ENERGY_W){1'b0}}, energy} - {{(EX_W-FP_W){1'b0}}, fp};
   /* verilator lint_on UNUSEDSIGNAL */
-  wire signed [FP_W:0] fp_neg = -{fp[FP_W-1], fp};
-  /* verilator lint_off UNUSEDSIGNAL */
-  wire [QW-1:0] q_mix_im = rnd_sat({{(QW-FP_W-1){fp_neg[FP_W]}}, fp_neg}, MIX_SHIFT, MIX_W);
-  /* verilator lint_on UNUSEDSIGNAL */
-
-  // E + y^2 - y_old^2 (y^2 and y_old^2 are non-negative, below 2^(2 DATA_W-2) + 1).
-  wire [EX_W-1:0] energy_next = {{(EX_W-ENERGY_W){1'b0}}, energy}
-                              + {{(EX_W-FP_W){1'b0}}, y2_r} - {{(EX_W-FP_W){1'b0}}, fp};
+  wire [ENERGY_W-1:0] energy_new = (fe_state == FE_M5) ? energy_sub[ENERGY_W-1:0] : energy;
 
   always @(posedge clk) begin
     if (rst) begin
       fe_state <= FE_IDLE;
-      y_r <= 0; y_old <= 0; fa <= 0; fb <= 0; fp <= 0; y2_r <= 0;
-      mix_re <= 0; mix_im <= 0; b_old_re <= 0; b_old_im <= 0;
+      y_r <= 0; fa <= 0; fb <= 0; fp <= 0;
+      mix_re <= 0; mix_im <= 0;
       acc_re <= 0; acc_im <= 0; energy <= 0;
       phase <= 0; b_ptr <= 0; b_full <= 1'b0; y_full <= 1'b0;
       y_ptr <= Y_LAST;  // the model pre-increments the window index
-      dphase <= 0; n_cnt <= 0;
-      dec_valid <= 1'b0; dec_re <= 0; dec_im <= 0; dec_energy <= 0; dec_index <= 0;
+      dphase <= 0;
+      bd_wptr <= BD_LAST; bd_cnt <= 0; bd_pend <= 1'b0;
+      eq0 <= 0; eq1 <= 0; eq_n <= 2'd0;
     end else begin
-      if (dec_take) dec_valid <= 1'b0;
+      if (a_start) bd_pend <= 1'b0;
+      // energy queue: pop at an output start, push at a hand-off (both may happen at once)
+      if (e_pop) begin
+        eq0 <= eq1;
+        if (hand) begin
+          if (eq_n == 2'd1) eq0 <= energy_new; else eq1 <= energy_new;
+        end else begin
+          eq_n <= eq_n - 1'b1;
+        end
+      end else if (hand) begin
+        if (eq_n == 2'd0) eq0 <= energy_new; else eq1 <= energy_new;
+        eq_n <= eq_n + 1'b1;
+      end
+      if (hand) begin
+        bd_wptr <= bd_wptr_next;
+        if (bd_cnt != TAPS_N) bd_cnt <= bd_cnt + 1'b1;
+        bd_pend <= 1'b1;
+      end
       case (fe_state)
         FE_IDLE: if (accept) begin
           y_r <= s_data;
           fa <= s_data;
-          fb <= {{(FB_W-LO_W){LO_COS[phase*LO_W+LO_W-1]}}, LO_COS[phase*LO_W +: LO_W]};
+          fb <= lo_rom(LO_C, phase);
           y_ptr <= y_ptr_next;  // y_rd holds y_mem[y_ptr] from FE_M2 on
           fe_state <= FE_M1;
         end
         FE_M1: begin
           fp <= fa * fb;  // y cos
-          fb <= {{(FB_W-LO_W){LO_SIN[phase*LO_W+LO_W-1]}}, LO_SIN[phase*LO_W +: LO_W]};
+          fb <= lo_rom(LO_NS, phase);
           fe_state <= FE_M2;
         end
         FE_M2: begin
-          fp <= fa * fb;  // y sin
-          mix_re <= q_mix_re[MIX_W-1:0];
-          y_old <= y_full ? y_rd : {DATA_W{1'b0}};
-          b_old_re <= b_full ? b_rd[2*MIX_W-1:MIX_W] : {MIX_W{1'b0}};
-          b_old_im <= b_full ? b_rd[MIX_W-1:0] : {MIX_W{1'b0}};
+          fp <= fa * fb;  // y (-sin)
+          mix_re <= q_mix_fp;
           fb <= {{(FB_W-DATA_W){y_r[DATA_W-1]}}, y_r};
           fe_state <= FE_M3;
         end
         FE_M3: begin
           fp <= fa * fb;  // y^2
-          mix_im <= q_mix_im[MIX_W-1:0];
+          mix_im <= q_mix_fp;
           fa <= y_old;
           fb <= {{(FB_W-DATA_W){y_old[DATA_W-1]}}, y_old};
           fe_state <= FE_M4;
         end
         FE_M4: begin  // memories written this cycle (fe_write)
           fp <= fa * fb;  // y_old^2
-          y2_r <= fp;
+          energy <= energy_add[ENERGY_W-1:0];
           acc_re <= acc_re + {{(DEC_W-MIX_W){mix_re[MIX_W-1]}}, mix_re}
                            - {{(DEC_W-MIX_W){b_old_re[MIX_W-1]}}, b_old_re};
           acc_im <= acc_im + {{(DEC_W-MIX_W){mix_im[MIX_W-1]}}, mix_im}
@@ -292,239 +485,353 @@ module correlator_bank #(
           fe_state <= FE_M5;
         end
         FE_M5: begin
-          energy <= energy_next[ENERGY_W-1:0];
-          n_cnt <= n_cnt + 1'b1;
+          energy <= energy_sub[ENERGY_W-1:0];
           if (dphase == D_LAST) begin
             dphase <= 0;
-            fe_state <= FE_HAND;
+            fe_state <= hand ? FE_IDLE : FE_HAND;
           end else begin
             dphase <= dphase + 1'b1;
             fe_state <= FE_IDLE;
           end
         end
-        FE_HAND: if (!dec_valid) begin
-          dec_valid <= 1'b1;
-          dec_re <= acc_re;
-          dec_im <= acc_im;
-          dec_energy <= energy;
-          dec_index <= n_cnt - 1'b1;
-          fe_state <= FE_IDLE;
-        end
+        FE_HAND: if (hand) fe_state <= FE_IDLE;
         default: fe_state <= FE_IDLE;
       endcase
     end
   end
 
-  // ---------------------------------------------------------------- back end
-  localparam [2:0] BE_IDLE = 3'd0, BE_FIR = 3'd1, BE_FQ = 3'd2, BE_COMB = 3'd3,
-                   BE_PWR = 3'd4, BE_DONE = 3'd5;
-  reg [2:0] be_state;
-  reg       m_valid_r;
-  assign dec_take = (be_state == BE_IDLE) && dec_valid && !m_valid_r;
+  // ================================================================ back end
+  // ---- shared multiplier pipeline: issue (operands, tag s1) -> product (tag s2) -> land
+  localparam [1:0] CL_A = 2'd0, CL_SQ = 2'd1, CL_W = 2'd2;
+  reg [LW-1:0]    ma, mb;
+  reg [2*LW-1:0]  mp;
+  reg             s1_v, s2_v;
+  reg [1:0]       s1_cl, s2_cl;
+  reg             s1_first, s2_first, s1_last, s2_last, s1_neg, s2_neg, s1_lane, s2_lane;
+  reg [SH_W-1:0]  s1_sh, s2_sh;
+  reg [JI_W-1:0]  s1_j, s2_j;
+  always @(posedge clk) mp <= ma * mb;
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [XW-1:0] psh = {{(XW-2*LW){1'b0}}, mp} << {s2_sh, 4'b0000};
+  /* verilator lint_on UNUSEDSIGNAL */
 
-  // Bd history
-  reg [2*DEC_W-1:0] bd_mem [0:TAPS-1];
-  reg [2*DEC_W-1:0] bd_rd;
-  reg [BA_W-1:0]    bd_wptr, bd_rptr;
-  reg [FA_W-1:0]    f_wptr, f_rptr;
-  wire [BA_W-1:0] bd_wptr_next = (bd_wptr == BD_LAST) ? {BA_W{1'b0}} : bd_wptr + 1'b1;
-  wire [FA_W-1:0] f_wptr_next  = (f_wptr == F_LAST) ? {FA_W{1'b0}} : f_wptr + 1'b1;
-  reg [TI_W-1:0]    bd_cnt, fir_i;
-  always @(posedge clk) begin
-    // Bd[k] is written when the handoff is taken, so the first FIR read sees it.
-    if (dec_take) bd_mem[bd_wptr_next] <= {dec_re, dec_im};
-    bd_rd <= bd_mem[bd_rptr];
-  end
-  // F history
+  // ---- stage A: chip FIR
+  reg             a_busy, a_lane;
+  reg [BA_W-1:0]  a_base, a_addr;
+  reg [TI_W-1:0]  a_cnt, a_i;
+  reg [LBA_W-1:0] a_la;
+  reg [LTB_W-1:0] a_lb;
+  reg [FIR_W-1:0] facc;
+  reg             fq_pend, fq_lane;
+  reg [CHIP_W-1:0] fres_re, fres_im;
+  reg             fres_valid;
+  wire a_tap_end  = (a_la == NBA_L) && (a_lb == NTB_L);
+  wire a_first    = (a_i == {TI_W{1'b0}}) && (a_la == {LBA_W{1'b0}}) && (a_lb == {LTB_W{1'b0}});
+  wire a_last     = (a_i == T_LAST) && a_tap_end;
+  wire [BA_W-1:0] a_addr_dec = (a_addr == {BA_W{1'b0}}) ? BD_LAST : a_addr - 1'b1;
+  wire signed [DEC_W-1:0] bd_lane = a_lane ? bd_rd[DEC_W-1:0] : bd_rd[2*DEC_W-1:DEC_W];
+  wire [DEC_W-1:0] bd_mag = bd_lane[DEC_W-1] ? -bd_lane : bd_lane;
+  wire [NBA*LW-1:0] bd_mag_p = {{(NBA*LW-DEC_W){1'b0}}, bd_mag};
+  wire [LW-1:0] a_opa = (a_i < a_cnt) ? bd_mag_p[a_la*LW +: LW] : {LW{1'b0}};
+  wire [TAPM_W:0] tap_sm = tap_rom(a_i);
+  wire [TAPM_W-1:0] tap_mag = tap_sm[TAPM_W-1:0];
+  wire [LW-1:0] a_opb = tap_mag[a_lb*LW +: LW];
+  wire a_neg = bd_lane[DEC_W-1] ^ tap_sm[TAPM_W];
+
+  // ---- combiner
+  localparam [1:0] C_IDLE = 2'd0, C_RUN = 2'd1, C_DRAIN = 2'd2, C_Q = 2'd3;
+  reg [1:0]        c_state;
+  reg [CI_W-1:0]   c_m, c_m1;
+  reg              c_iss1, c_dv1;
+  reg [RI_W-1:0]   c_round;
+  reg [JI_W-1:0]   c_ja;
+  reg [FA_W-1:0]   f_wptr, f_rptr, f_old;
+  reg [DIST_W-1:0] f_cnt, f_dist;
+  reg [CA_W-1:0]   ca_re, ca_im, cb_re, cb_im;
   reg [2*CHIP_W-1:0] f_mem [0:FN-1];
   reg [2*CHIP_W-1:0] f_rd;
-  reg [DIST_W-1:0]   f_cnt, f_dist;
+  wire [FA_W-1:0] f_wptr_next = (f_wptr == F_LAST) ? {FA_W{1'b0}} : f_wptr + 1'b1;
+  wire [FA_W-1:0] f_oldest    = (f_wptr_next == F_LAST) ? {FA_W{1'b0}} : f_wptr_next + 1'b1;
+  wire [FA_W:0]   f_rptr_step = {1'b0, f_rptr} + STEP_A;
   /* verilator lint_off UNUSEDSIGNAL */
-  wire [QW-1:0] q_chip_re, q_chip_im;  // low CHIP_W bits used
+  wire [FA_W:0]   f_rptr_wrap = f_rptr_step - FN_A;  // used only when >= 0: top bit is 0
   /* verilator lint_on UNUSEDSIGNAL */
+  wire signed [CHIP_W-1:0] f_rd_re = f_rd[2*CHIP_W-1:CHIP_W];
+  wire signed [CHIP_W-1:0] f_rd_im = f_rd[CHIP_W-1:0];
+  wire signed [CA_W-1:0] f_re_x = {{(CA_W-CHIP_W){f_rd_re[CHIP_W-1]}}, f_rd_re};
+  wire signed [CA_W-1:0] f_im_x = {{(CA_W-CHIP_W){f_rd_im[CHIP_W-1]}}, f_rd_im};
+  wire [JI_W-1:0] c_jb = c_ja + 1'b1;
+  wire c_has_b = (c_jb < CODES_N);
+  wire sa = code_rom(c_ja, c_m1);
+  wire sb = c_has_b ? code_rom(c_jb, c_m1) : 1'b1;
+  wire b_start;
+  wire f_write = b_start;
   always @(posedge clk) begin
-    if (be_state == BE_FQ) f_mem[f_wptr_next] <= {q_chip_re[CHIP_W-1:0], q_chip_im[CHIP_W-1:0]};
+    if (f_write) f_mem[f_wptr_next] <= {fres_re, fres_im};
     f_rd <= f_mem[f_rptr];
   end
 
-  // FIR / power lanes
-  reg signed [TAP_W-1:0]  tap_r;
-  reg signed [MA_W-1:0]   ma_re, ma_im;
-  reg signed [MB_W-1:0]   mb_re, mb_im;
-  reg signed [LP_W-1:0]   lp_re, lp_im;
-  reg signed [FACC_W-1:0] facc_re, facc_im;
-  reg                     iss1, iss2, iss3, iss4, iss5;  // pipeline stage valid
-  reg                     dv1, dv2, dv3;                  // data valid (history filled)
-  reg [JI_W-1:0]          j1, j2, j3, j4, j5;          // code index tags (power loop)
-  reg [CI_W-1:0]          comb_c, c1;
-  reg [JI_W-1:0]          pw_j;
-  reg [CA_W*CODES-1:0]    cacc_re, cacc_im;
-  reg signed [CORR_W-1:0] cq_re, cq_im;
-  reg [PW_W-1:0]          pw;
-  reg [WEIGHT_W-1:0]      wgt;
-  /* verilator lint_off UNUSEDSIGNAL */
-  reg [WP_W-1:0]          wp;  // top WP_W-WEIGHTED_W bits are provably zero (header)
-  /* verilator lint_on UNUSEDSIGNAL */
+  // ---- SQ and W engines
+  reg [CORR_W-1:0] cq_ar, cq_ai, cq_br, cq_bi;
+  reg              cq_valid, cq_two;
+  reg [JI_W-1:0]   cq_j;
+  reg              sq_c, sq_p;
+  reg [LC_W-1:0]   sq_la, sq_lb;
+  reg [PW_W-1:0]   p_acc, p_w;
+  reg              pw_valid;
+  reg [JI_W-1:0]   pw_j;
+  reg [LP_W-1:0]   w_la;
+  reg [LWT_W-1:0]  w_lb;
+  reg [WEIGHTED_W-1:0] q_acc;
+  wire [CORR_W-1:0] sq_val = sq_c ? (sq_p ? cq_bi : cq_br) : (sq_p ? cq_ai : cq_ar);
+  wire [CORR_W-1:0] sq_mag = sq_val[CORR_W-1] ? -sq_val : sq_val;
+  wire [NC*LW-1:0]  sq_mag_p = {{(NC*LW-CORR_W){1'b0}}, sq_mag};
+  wire sq_first = !sq_p && (sq_la == {LC_W{1'b0}}) && (sq_lb == {LC_W{1'b0}});
+  wire sq_last  = sq_p && (sq_la == NC_L) && (sq_lb == NC_L);
+  wire sq_final = sq_last && (sq_c == cq_two);
+  // P_w is written 2 clocks after a code's last SQ product issues: it may issue only if the
+  // W engine will have read the previous P_w by then.
+  wire sq_guard = (!(s1_v && s1_cl == CL_SQ && s1_last) || NWOP <= 1) &&
+                  (!(s2_v && s2_cl == CL_SQ && s2_last) || NWOP <= 2);
+  wire [NP*LW-1:0]  pw_p = {{(NP*LW-PW_W){1'b0}}, p_w};
+  wire [WTP_W-1:0]  wt = wt_rom(pw_j);
+  wire w_last = (w_la == NP_L) && (w_lb == NW_L);
+
+  wire w_iss  = pw_valid;
+  wire sq_iss = !pw_valid && cq_valid && (!sq_last || sq_guard);
+  // F_re is written 2 clocks after the last re product issues: only when fres is free.
+  wire a_iss  = !w_iss && !sq_iss && a_busy && !(!a_lane && a_last && fres_valid);
+
+  // ---- output
+  reg       b_busy, m_valid_r;
   reg [ENERGY_W-1:0]      out_energy;
   reg [TIME_W-1:0]        out_index;
   reg signed [CHIP_W-1:0] out_chip_re, out_chip_im;
   reg [CODES*CORR_W-1:0]  out_corr_re, out_corr_im;
   reg [CODES*WEIGHTED_W-1:0] out_weighted;
+  wire b_tags = (s1_v && s1_cl != CL_A) || (s2_v && s2_cl != CL_A);
+  wire b_done = b_busy && (c_state == C_IDLE) && !cq_valid && !pw_valid && !b_tags;
+  assign b_start = !b_busy && fres_valid && !m_valid_r;
+  assign e_pop = b_start;
+  assign a_start = !a_busy && bd_pend;
 
-  assign q_chip_re = rnd_sat({{(QW-FACC_W){facc_re[FACC_W-1]}}, facc_re}, CHIP_SHIFT, CHIP_W);
-  assign q_chip_im = rnd_sat({{(QW-FACC_W){facc_im[FACC_W-1]}}, facc_im}, CHIP_SHIFT, CHIP_W);
-  wire signed [CA_W-1:0] cacc_re_j = cacc_re[pw_j*CA_W +: CA_W];
-  wire signed [CA_W-1:0] cacc_im_j = cacc_im[pw_j*CA_W +: CA_W];
-  /* verilator lint_off UNUSEDSIGNAL */
-  wire [QW-1:0] q_corr_re = rnd_sat({{(QW-CA_W){cacc_re_j[CA_W-1]}}, cacc_re_j}, CORR_SHIFT, CORR_W);
-  wire [QW-1:0] q_corr_im = rnd_sat({{(QW-CA_W){cacc_im_j[CA_W-1]}}, cacc_im_j}, CORR_SHIFT, CORR_W);
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire signed [DEC_W-1:0]  bd_rd_re = bd_rd[2*DEC_W-1:DEC_W];
-  wire signed [DEC_W-1:0]  bd_rd_im = bd_rd[DEC_W-1:0];
-  wire signed [CHIP_W-1:0] f_rd_re = f_rd[2*CHIP_W-1:CHIP_W];
-  wire signed [CHIP_W-1:0] f_rd_im = f_rd[CHIP_W-1:0];
-  wire signed [CA_W-1:0]   f_re_x = {{(CA_W-CHIP_W){f_rd_re[CHIP_W-1]}}, f_rd_re};
-  wire signed [CA_W-1:0]   f_im_x = {{(CA_W-CHIP_W){f_rd_im[CHIP_W-1]}}, f_rd_im};
-  wire [FA_W:0]   f_rptr_step  = {1'b0, f_rptr} + STEP_A;
-  /* verilator lint_off UNUSEDSIGNAL */
-  wire [FA_W:0]   f_rptr_wrap  = f_rptr_step - FN_A;  // used only when >= 0: top bit is 0
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire [FA_W-1:0] f_rptr_nx    = f_rptr_wrap[FA_W-1:0];
+  // FIR read address: the Bd entry of the op presented next clock.
+  always @(*) begin
+    if (a_start) a_addr_nx = bd_wptr;
+    else if (a_iss && a_tap_end) a_addr_nx = (a_i == T_LAST) ? a_base : a_addr_dec;
+    else a_addr_nx = a_addr;
+  end
 
-  integer j;
+  wire [WEIGHTED_W-1:0] q_sum = (s2_first ? {WEIGHTED_W{1'b0}} : q_acc) + psh[WEIGHTED_W-1:0];
+  wire [FIR_W-1:0] facc_base = s2_first ? {FIR_W{1'b0}} : facc;
+
   always @(posedge clk) begin
     if (rst) begin
-      be_state <= BE_IDLE; m_valid_r <= 1'b0;
-      bd_wptr <= BD_LAST; bd_rptr <= 0; bd_cnt <= 0; fir_i <= 0; 
-      f_wptr <= F_LAST; f_rptr <= 0; f_cnt <= 0; f_dist <= 0; 
-      tap_r <= 0; ma_re <= 0; ma_im <= 0; mb_re <= 0; mb_im <= 0; lp_re <= 0; lp_im <= 0;
-      facc_re <= 0; facc_im <= 0;
-      iss1 <= 1'b0; iss2 <= 1'b0; iss3 <= 1'b0; iss4 <= 1'b0; iss5 <= 1'b0;
-      dv1 <= 1'b0; dv2 <= 1'b0; dv3 <= 1'b0;
-      j1 <= 0; j2 <= 0; j3 <= 0; j4 <= 0; j5 <= 0;
-      comb_c <= 0; c1 <= 0; pw_j <= 0;
-      cacc_re <= 0; cacc_im <= 0; cq_re <= 0; cq_im <= 0; pw <= 0; wgt <= 0; wp <= 0;
-      out_energy <= 0; out_index <= 0; out_chip_re <= 0; out_chip_im <= 0;
+      s1_v <= 1'b0; s2_v <= 1'b0; s1_cl <= CL_A; s2_cl <= CL_A;
+      s1_first <= 1'b0; s2_first <= 1'b0; s1_last <= 1'b0; s2_last <= 1'b0;
+      s1_neg <= 1'b0; s2_neg <= 1'b0; s1_lane <= 1'b0; s2_lane <= 1'b0;
+      s1_sh <= 0; s2_sh <= 0; s1_j <= 0; s2_j <= 0;
+      a_busy <= 1'b0; a_lane <= 1'b0; a_base <= 0; a_addr <= 0; a_cnt <= 0; a_i <= 0;
+      a_la <= 0; a_lb <= 0; facc <= 0; fq_pend <= 1'b0; fq_lane <= 1'b0;
+      fres_re <= 0; fres_im <= 0; fres_valid <= 1'b0;
+      c_state <= C_IDLE; c_m <= 0; c_m1 <= 0; c_iss1 <= 1'b0; c_dv1 <= 1'b0; c_round <= 0;
+      c_ja <= 0; f_wptr <= F_LAST; f_rptr <= 0; f_old <= 0; f_cnt <= 0; f_dist <= 0;
+      ca_re <= 0; ca_im <= 0; cb_re <= 0; cb_im <= 0;
+      cq_ar <= 0; cq_ai <= 0; cq_br <= 0; cq_bi <= 0; cq_valid <= 1'b0; cq_two <= 1'b0;
+      cq_j <= 0; sq_c <= 1'b0; sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
+      p_acc <= 0; p_w <= 0; pw_valid <= 1'b0; pw_j <= 0; w_la <= 0; w_lb <= 0; q_acc <= 0;
+      b_busy <= 1'b0; m_valid_r <= 1'b0;
+      out_energy <= 0; out_index <= {TIME_W{1'b1}};  // + DECIM = DECIM-1 at the first output
+      out_chip_re <= 0; out_chip_im <= 0;
       out_corr_re <= 0; out_corr_im <= 0; out_weighted <= 0;
     end else begin
       if (m_valid_r && m_ready) m_valid_r <= 1'b0;
-      case (be_state)
-        BE_IDLE: if (dec_take) begin
-          bd_wptr <= bd_wptr_next;
-          bd_rptr <= bd_wptr_next;
-          if (bd_cnt != TAPS_N) bd_cnt <= bd_cnt + 1'b1;
-          out_energy <= dec_energy;
-          out_index <= dec_index;
-          fir_i <= 0;
-          facc_re <= 0; facc_im <= 0;
-          be_state <= BE_FIR;
+      a_addr <= a_addr_nx;
+
+      // ---------------- issue (one limb product per clock)
+      s1_v <= w_iss || sq_iss || a_iss;
+      if (w_iss) begin
+        ma <= pw_p[w_la*LW +: LW];
+        mb <= wt[w_lb*LW +: LW];
+        s1_cl <= CL_W; s1_first <= (w_la == {LP_W{1'b0}}) && (w_lb == {LWT_W{1'b0}});
+        s1_last <= w_last; s1_neg <= 1'b0;
+        s1_sh <= SH_ZERO + w_la + w_lb; s1_j <= pw_j;
+        if (w_lb == NW_L) begin
+          w_lb <= 0;
+          w_la <= (w_la == NP_L) ? {LP_W{1'b0}} : w_la + 1'b1;
+        end else begin
+          w_lb <= w_lb + 1'b1;
         end
-        BE_FIR: begin
-          // stage 0: read Bd[k-i] (write of Bd[k] landed last cycle) and tap g[i]
-          iss1 <= 1'b0;
-          if (fir_i != TAPS_N) begin
-            iss1 <= 1'b1;
-            dv1 <= (fir_i < bd_cnt);
-            tap_r <= TAP_VALUES[fir_i*TAP_W +: TAP_W];
-            bd_rptr <= (bd_rptr == {BA_W{1'b0}}) ? BD_LAST : bd_rptr - 1'b1;
-            fir_i <= fir_i + 1'b1;
-          end
-          // stage 1: operands
-          iss2 <= iss1; dv2 <= dv1;
-          ma_re <= {{(MA_W-DEC_W){bd_rd_re[DEC_W-1]}}, bd_rd_re};
-          ma_im <= {{(MA_W-DEC_W){bd_rd_im[DEC_W-1]}}, bd_rd_im};
-          mb_re <= {{(MB_W-TAP_W){tap_r[TAP_W-1]}}, tap_r};
-          mb_im <= {{(MB_W-TAP_W){tap_r[TAP_W-1]}}, tap_r};
-          // stage 2: products
-          iss3 <= iss2; dv3 <= dv2;
-          lp_re <= ma_re * mb_re;
-          lp_im <= ma_im * mb_im;
-          // stage 3: accumulate (entries not written since reset read as zero)
-          if (iss3 && dv3) begin
-            facc_re <= facc_re + {{(FACC_W-LP_W){lp_re[LP_W-1]}}, lp_re};
-            facc_im <= facc_im + {{(FACC_W-LP_W){lp_im[LP_W-1]}}, lp_im};
-          end
-          if (fir_i == TAPS_N && !iss1 && !iss2 && !iss3) be_state <= BE_FQ;
-        end
-        BE_FQ: begin
-          out_chip_re <= q_chip_re[CHIP_W-1:0];
-          out_chip_im <= q_chip_im[CHIP_W-1:0];
-          f_wptr <= f_wptr_next;
-          // oldest combiner tap: k - (CHIPS-1) CHIP_STEP = k + 1 (mod FN)
-          f_rptr <= (f_wptr_next == F_LAST) ? {FA_W{1'b0}} : f_wptr_next + 1'b1;
-          f_dist <= DIST0;
-          if (f_cnt != FN_N) f_cnt <= f_cnt + 1'b1;
-          comb_c <= 0;
-          cacc_re <= 0; cacc_im <= 0;
-          be_state <= BE_COMB;
-        end
-        BE_COMB: begin
-          iss1 <= 1'b0;
-          if (comb_c != CHIPS_N) begin
-            iss1 <= 1'b1;
-            dv1 <= (f_dist < f_cnt);
-            c1 <= comb_c;
-            comb_c <= comb_c + 1'b1;
-            f_rptr <= (f_rptr_step >= FN_A) ? f_rptr_nx : f_rptr_step[FA_W-1:0];
-            f_dist <= f_dist - STEP_D;
-          end
-          if (iss1 && dv1) begin
-            for (j = 0; j < CODES; j = j + 1) begin
-              if (CODE_BITS[j*CHIPS + {{(32-CI_W){1'b0}}, c1}]) begin
-                cacc_re[j*CA_W +: CA_W] <= cacc_re[j*CA_W +: CA_W] + f_re_x;
-                cacc_im[j*CA_W +: CA_W] <= cacc_im[j*CA_W +: CA_W] + f_im_x;
-              end else begin
-                cacc_re[j*CA_W +: CA_W] <= cacc_re[j*CA_W +: CA_W] - f_re_x;
-                cacc_im[j*CA_W +: CA_W] <= cacc_im[j*CA_W +: CA_W] - f_im_x;
+        if (w_last) pw_valid <= 1'b0;
+      end else if (sq_iss) begin
+        ma <= sq_mag_p[sq_la*LW +: LW];
+        mb <= sq_mag_p[sq_lb*LW +: LW];
+        s1_cl <= CL_SQ; s1_first <= sq_first; s1_last <= sq_last; s1_neg <= 1'b0;
+        s1_sh <= SH_ZERO + sq_la + sq_lb; s1_j <= cq_j + {{(JI_W-1){1'b0}}, sq_c};
+        if (sq_lb == NC_L) begin
+          sq_lb <= 0;
+          if (sq_la == NC_L) begin
+            sq_la <= 0;
+            sq_p <= !sq_p;
+            if (sq_p) begin
+              sq_c <= !sq_c;
+              if (sq_final) begin
+                sq_c <= 1'b0;
+                cq_valid <= 1'b0;
               end
             end
+          end else begin
+            sq_la <= sq_la + 1'b1;
           end
-          if (comb_c == CHIPS_N && !iss1) begin
-            pw_j <= 0;
-            be_state <= BE_PWR;
+        end else begin
+          sq_lb <= sq_lb + 1'b1;
+        end
+      end else begin
+        ma <= a_opa;
+        mb <= a_opb;
+        s1_cl <= CL_A; s1_first <= a_first; s1_last <= a_last; s1_neg <= a_neg;
+        s1_sh <= SH_ZERO + a_la + a_lb; s1_lane <= a_lane;
+      end
+      if (a_iss) begin
+        if (a_lb == NTB_L) begin
+          a_lb <= 0;
+          if (a_la == NBA_L) begin
+            a_la <= 0;
+            if (a_i == T_LAST) begin
+              a_i <= 0;
+              a_lane <= !a_lane;
+              if (a_lane) a_busy <= 1'b0;
+            end else begin
+              a_i <= a_i + 1'b1;
+            end
+          end else begin
+            a_la <= a_la + 1'b1;
+          end
+        end else begin
+          a_lb <= a_lb + 1'b1;
+        end
+      end
+      if (a_start) begin
+        a_busy <= 1'b1;
+        a_lane <= 1'b0; a_i <= 0; a_la <= 0; a_lb <= 0;
+        a_base <= bd_wptr;
+        a_cnt <= bd_cnt;
+      end
+
+      // ---------------- product stage
+      s2_v <= s1_v; s2_cl <= s1_cl; s2_first <= s1_first; s2_last <= s1_last;
+      s2_neg <= s1_neg; s2_sh <= s1_sh; s2_j <= s1_j; s2_lane <= s1_lane;
+
+      // ---------------- land
+      if (fq_pend) begin
+        fq_pend <= 1'b0;
+        if (fq_lane) begin
+          fres_im <= q_chip(facc);
+          fres_valid <= 1'b1;
+        end else begin
+          fres_re <= q_chip(facc);
+        end
+      end
+      if (s2_v) begin
+        case (s2_cl)
+          CL_A: begin
+            facc <= s2_neg ? facc_base - psh[FIR_W-1:0] : facc_base + psh[FIR_W-1:0];
+            if (s2_last) begin
+              fq_pend <= 1'b1;
+              fq_lane <= s2_lane;
+            end
+          end
+          CL_SQ: begin
+            if (s2_first) p_acc <= psh[PW_W-1:0];
+            else if (s2_last) begin
+              p_w <= p_acc + psh[PW_W-1:0];
+              pw_valid <= 1'b1;
+              pw_j <= s2_j;
+            end else p_acc <= p_acc + psh[PW_W-1:0];
+          end
+          default: begin
+            if (s2_last) out_weighted[s2_j*WEIGHTED_W +: WEIGHTED_W] <= q_sum;
+            else q_acc <= q_sum;
+          end
+        endcase
+      end
+
+      // ---------------- combiner
+      c_iss1 <= 1'b0;
+      if (c_iss1) begin
+        if (c_m1 == {CI_W{1'b0}}) begin
+          ca_re <= c_dv1 ? (sa ? f_re_x : -f_re_x) : {CA_W{1'b0}};
+          ca_im <= c_dv1 ? (sa ? f_im_x : -f_im_x) : {CA_W{1'b0}};
+          cb_re <= c_dv1 ? (sb ? f_re_x : -f_re_x) : {CA_W{1'b0}};
+          cb_im <= c_dv1 ? (sb ? f_im_x : -f_im_x) : {CA_W{1'b0}};
+        end else if (c_dv1) begin
+          ca_re <= sa ? ca_re + f_re_x : ca_re - f_re_x;
+          ca_im <= sa ? ca_im + f_im_x : ca_im - f_im_x;
+          cb_re <= sb ? cb_re + f_re_x : cb_re - f_re_x;
+          cb_im <= sb ? cb_im + f_im_x : cb_im - f_im_x;
+        end
+      end
+      case (c_state)
+        C_RUN: begin
+          c_iss1 <= 1'b1;
+          c_m1 <= c_m;
+          c_dv1 <= (f_dist < f_cnt);
+          f_rptr <= (f_rptr_step >= FN_A) ? f_rptr_wrap[FA_W-1:0] : f_rptr_step[FA_W-1:0];
+          f_dist <= f_dist - STEP_D;
+          if (c_m == C_LAST) c_state <= C_DRAIN;
+          c_m <= c_m + 1'b1;
+        end
+        C_DRAIN: c_state <= C_Q;  // the last tap is accumulated this clock
+        C_Q: if (!cq_valid) begin
+          cq_ar <= q_corr(ca_re); cq_ai <= q_corr(ca_im);
+          cq_br <= q_corr(cb_re); cq_bi <= q_corr(cb_im);
+          out_corr_re[c_ja*CORR_W +: CORR_W] <= q_corr(ca_re);
+          out_corr_im[c_ja*CORR_W +: CORR_W] <= q_corr(ca_im);
+          if (c_has_b) begin
+            out_corr_re[c_jb*CORR_W +: CORR_W] <= q_corr(cb_re);
+            out_corr_im[c_jb*CORR_W +: CORR_W] <= q_corr(cb_im);
+          end
+          cq_valid <= 1'b1;
+          cq_two <= c_has_b;
+          cq_j <= c_ja;
+          sq_c <= 1'b0; sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
+          if (c_round == R_LAST) begin
+            c_state <= C_IDLE;
+          end else begin
+            c_round <= c_round + 1'b1;
+            c_ja <= c_jb + 1'b1;
+            c_m <= 0;
+            f_rptr <= f_old;
+            f_dist <= DIST0;
+            c_state <= C_RUN;
           end
         end
-        BE_PWR: begin
-          // stage 0: quantize C_j
-          iss1 <= 1'b0;
-          if (pw_j != CODES_N) begin
-            iss1 <= 1'b1;
-            j1 <= pw_j;
-            cq_re <= q_corr_re[CORR_W-1:0];
-            cq_im <= q_corr_im[CORR_W-1:0];
-            pw_j <= pw_j + 1'b1;
-          end
-          // stage 1: publish Cq_j, operands of the squares
-          iss2 <= iss1; j2 <= j1;
-          if (iss1) begin
-            out_corr_re[j1*CORR_W +: CORR_W] <= cq_re;
-            out_corr_im[j1*CORR_W +: CORR_W] <= cq_im;
-          end
-          ma_re <= {{(MA_W-CORR_W){cq_re[CORR_W-1]}}, cq_re};
-          mb_re <= {{(MB_W-CORR_W){cq_re[CORR_W-1]}}, cq_re};
-          ma_im <= {{(MA_W-CORR_W){cq_im[CORR_W-1]}}, cq_im};
-          mb_im <= {{(MB_W-CORR_W){cq_im[CORR_W-1]}}, cq_im};
-          // stage 2: squares
-          iss3 <= iss2; j3 <= j2;
-          lp_re <= ma_re * mb_re;
-          lp_im <= ma_im * mb_im;
-          // stage 3: power and weight operand
-          iss4 <= iss3; j4 <= j3;
-          pw <= lp_re[PW_W-1:0] + lp_im[PW_W-1:0];
-          wgt <= WEIGHTS[j3*WEIGHT_W +: WEIGHT_W];
-          // stage 4: weighted power
-          iss5 <= iss4; j5 <= j4;
-          wp <= pw * wgt;
-          // stage 5: publish Q_j
-          if (iss5) out_weighted[j5*WEIGHTED_W +: WEIGHTED_W] <= wp[WEIGHTED_W-1:0];
-          if (pw_j == CODES_N && !iss1 && !iss2 && !iss3 && !iss4 && !iss5) be_state <= BE_DONE;
-        end
-        BE_DONE: begin
-          m_valid_r <= 1'b1;
-          be_state <= BE_IDLE;
-        end
-        default: be_state <= BE_IDLE;
+        default: ;
       endcase
+
+      // ---------------- output start / end
+      if (b_start) begin
+        b_busy <= 1'b1;
+        fres_valid <= 1'b0;
+        out_chip_re <= fres_re;
+        out_chip_im <= fres_im;
+        out_energy <= eq0;
+        out_index <= out_index + DECIM_T;
+        f_wptr <= f_wptr_next;
+        if (f_cnt != FN_N) f_cnt <= f_cnt + 1'b1;
+        // oldest combiner tap: k - (CHIPS-1) CHIP_STEP = k + 1 (mod FN)
+        f_rptr <= f_oldest;
+        f_old <= f_oldest;
+        f_dist <= DIST0;
+        c_m <= 0;
+        c_round <= 0;
+        c_ja <= 0;
+        c_state <= C_RUN;
+      end
+      if (b_done) begin
+        b_busy <= 1'b0;
+        m_valid_r <= 1'b1;
+      end
     end
   end
 
