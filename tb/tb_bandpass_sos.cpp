@@ -200,6 +200,44 @@ class SosBench {
     }
   }
 
+  // Offers in[i] for exactly one clock every `every` clocks with m_ready held high; returns
+  // how many offers were refused (s_ready low) -- those are retried at the next slot.
+  std::uint64_t stream_every(const std::vector<std::int64_t>& in, int every) {
+    std::vector<std::int64_t> exp_y;
+    std::vector<std::vector<std::int64_t>> exp_s;
+    for (std::int64_t x : in) {
+      exp_y.push_back(model_.execute_raw(x));
+      exp_s.push_back(model_.section_outputs());
+    }
+    Dut& t = h_.top();
+    t.m_ready = 1;
+    std::size_t ii = 0, oi = 0;
+    std::uint64_t refused = 0;
+    const std::uint64_t limit = h_.cycles() + static_cast<std::uint64_t>(every) * in.size() + 10000;
+    for (std::uint64_t c = 0; oi < in.size(); ++c) {
+      if (h_.cycles() > limit) {
+        ADD_FAILURE() << "bandpass_sos: no progress after " << oi << " of " << in.size() << " outputs";
+        ++mismatches_;
+        return refused;
+      }
+      const bool offer = ii < in.size() && c % static_cast<std::uint64_t>(every) == 0;
+      t.s_valid = offer;
+      tb::set_port(t.s_data, offer ? in[ii] : static_cast<std::int64_t>(rng_()), in_w_);
+      h_.settle();
+      if (t.m_valid) {
+        check(oi, exp_y[oi], exp_s[oi]);
+        ++oi;
+      }
+      if (offer) {
+        if (t.s_ready) ++ii;
+        else ++refused;
+      }
+      h_.tick();
+    }
+    t.s_valid = 0;
+    return refused;
+  }
+
   // Offers `n` samples at full rate with random m_ready and stops in mid-flight, without
   // checking (a reset follows); the model does not see them.
   void push_unchecked(const std::vector<std::int64_t>& in, std::size_t cycles) {
@@ -526,18 +564,44 @@ TEST(BandpassSosRtl, ResetMidStreamGivesAFreshFilter) {
   EXPECT_EQ(b.protocol_errors(), 0u);
 }
 
+// The schedule the header documents: shared multipliers (two sections per SB_MAC16, one
+// sample every 6 clocks) when every section is a g*[1,0,-1] numerator with 2*b0, -a1, -a2
+// representable; otherwise one multiplier per section, P = 4 + (b1 != 0) clocks.
+struct Schedule {
+  bool shared = true;
+  int period = 0, latency = 0;
+};
+
+Schedule documented_schedule(const BandpassFixed& m) {
+  const int cb = m.config().coef_bits;
+  const std::int64_t lo = -(std::int64_t{1} << (cb - 1)), half = std::int64_t{1} << (cb - 2);
+  Schedule s;
+  for (const auto& c : m.coefficients()) {
+    if (c[1] != 0 || c[2] != -c[0] || c[0] < -half || c[0] >= half || c[3] == lo || c[4] == lo) s.shared = false;
+  }
+  const int n = static_cast<int>(m.coefficients().size());
+  if (s.shared) {
+    s.period = 6;
+    s.latency = 2 + 13 * ((n - 1) / 2) + 9 * ((n - 1) % 2) + 2;
+  } else {
+    s.latency = -1;
+    for (const auto& c : m.coefficients()) {
+      const int p = 4 + (c[1] != 0 ? 1 : 0);
+      s.latency += p + 4;
+      s.period = std::max(s.period, p);
+    }
+  }
+  return s;
+}
+
 TEST(BandpassSosRtl, LatencyAndThroughputAsDocumented) {
   SosBench b("tb_bandpass_sos_timing", 15);
-  // Header: P = 4 + (b1 != 0) cycles per sample and section; latency
-  // sum (P_k + 3) + SECTIONS - 1.
-  int latency = -1, period = 0;
-  for (const auto& c : b.model().coefficients()) {
-    const int p = 4 + (c[1] != 0 ? 1 : 0);
-    latency += p + 4;
-    period = std::max(period, p);
-  }
+  const Schedule sch = documented_schedule(b.model());
+  EXPECT_TRUE(sch.shared) << "the default filter should use the shared-multiplier schedule";
+  const int latency = sch.latency, period = sch.period;
   Dut& t = b.harness().top();
   t.m_ready = 1;
+  for (int c = 0; c < 8; ++c) b.harness().tick();  // idle: the shared schedule parks at its input slot
   t.s_valid = 1;
   tb::set_port(t.s_data, 1000, b.in_bits());
   b.harness().settle();
@@ -551,7 +615,8 @@ TEST(BandpassSosRtl, LatencyAndThroughputAsDocumented) {
   }
   EXPECT_EQ(cycles, latency);
   b.harness().tick();
-  // Throughput: with s_valid and m_ready held high, one sample every `period` cycles.
+  // Throughput: with s_valid and m_ready held high, one sample every `period` cycles (the
+  // shared schedule's input register takes a second sample right after the first).
   b.harness().reset(2);
   t.s_valid = 1;
   t.m_ready = 1;
@@ -562,7 +627,27 @@ TEST(BandpassSosRtl, LatencyAndThroughputAsDocumented) {
     b.harness().tick();
   }
   ASSERT_GT(accept_at.size(), 10u);
-  for (std::size_t i = 1; i < accept_at.size(); ++i) EXPECT_EQ(accept_at[i] - accept_at[i - 1], static_cast<std::uint64_t>(period));
+  for (std::size_t i = sch.shared ? 2 : 1; i < accept_at.size(); ++i) {
+    EXPECT_EQ(accept_at[i] - accept_at[i - 1], static_cast<std::uint64_t>(period)) << "accept " << i;
+  }
+}
+
+// The 5 MS/s stream at a 30 MHz clock: one sample offered every 6 clocks (for one clock),
+// m_ready always high. The filter must be ready every time (it never stalls the ADC) and
+// still match the model bit for bit.
+TEST(BandpassSosRtl, OneSampleEverySixClocksNeverStalls) {
+  SosBench b("tb_bandpass_sos_6clk", 16);
+  std::uint64_t seed = 900, offered = 0;
+  for (const Code& code : code_family("Gold4").codes) {
+    const auto x = coded_echo(code, 0.100, 0.02, ++seed, b.in_bits());
+    const std::uint64_t refused = b.stream_every(x, 6);
+    offered += x.size();
+    EXPECT_EQ(refused, 0u) << "s_ready low when a sample was offered";
+  }
+  report("one sample every 6 clocks", b);
+  EXPECT_EQ(b.compared(), offered);
+  EXPECT_EQ(b.mismatches(), 0u);
+  EXPECT_EQ(b.protocol_errors(), 0u);
 }
 
 TEST(BandpassSosRtl, VerilatorLintClean) {
@@ -580,6 +665,9 @@ TEST(BandpassSosRtl, IcarusBitExactAcrossModes) {
   // round-half-up differ; b1 != 0 selects the 5-product schedule.
   SosFilter coarse = d.filter;
   coarse.sections = {Biquad{0.25, 0.125, -0.25, -1.5, 0.625}, Biquad{0.5, -0.375, 0.125, -1.25, 0.5}};
+  // An even section count on the shared schedule (the last pair is full).
+  SosFilter four = d.filter;
+  four.sections.resize(4);
   struct Variant {
     std::string name;
     const SosFilter* filter;
@@ -602,6 +690,8 @@ TEST(BandpassSosRtl, IcarusBitExactAcrossModes) {
       {"trunc_wrap_q1_12", &d.filter, cfg(Rounding::Truncate, Overflow::Wrap, 12, 14, 13, 12), false, true},
       {"conv_sat_coarse", &coarse, cfg(Rounding::Convergent, Overflow::Saturate, 12, 14, 12, 11), false, true},
       {"conv_wrap_coarse", &coarse, cfg(Rounding::Convergent, Overflow::Wrap, 12, 14, 12, 11), false, false},
+      {"conv_wrap_default_filter_coef10", &d.filter, cfg(Rounding::Convergent, Overflow::Wrap, 12, 10, 13, 12), false, true},
+      {"trunc_sat_four_sections", &four, cfg(Rounding::Truncate, Overflow::Saturate, 12, 14, 13, 12), false, true},
       {"halfup_wrap_in10_coef13", &d.filter, cfg(Rounding::RoundHalfUp, Overflow::Wrap, 10, 13, 16, 14), false, true},
   };
   int seed = 1;
