@@ -32,7 +32,7 @@
 //            distance 0), bit 1 ToF or distance saturated.
 //
 // Timing:    sequential (no DSP): up to CODES-1 cycles to step back to code j's
-//            burst, 1-2 cycles for the ToF, TOF_W cycles of shift-add
+//            burst, 1-2 cycles for the ToF, TOF_W cycles of shift-add (one C_W+1-bit adder)
 //            multiply, then the result waits on m_ready. s_ready is high only
 //            when idle: under 50 cycles per event, events come every PERIOD_T
 //            samples.
@@ -98,8 +98,11 @@ module tof_distance #(
   reg signed [TW-1:0] t;      // candidate burst start
   reg [KW:0] k;
   reg no_tx, sat;
+  // Product ToF * C by right-shifting shift-add: {hi, mplier} holds the partial product;
+  // each step adds C to hi when the multiplier's low bit is 1 and shifts the pair right,
+  // so after TOF_W steps {hi, mplier} = ToF * C (PW bits) with only a C_W+1-bit adder.
   reg [TOF_W-1:0] mplier;
-  reg [PW-1:0] mcand, acc;
+  reg [C_W-1:0] hi;      // < 2^C_W after every step: (hi + C) / 2 < 2^C_W
   reg [C_W-1:0] c_used;
   reg [MCW-1:0] mcount;
 
@@ -115,8 +118,10 @@ module tof_distance #(
   wire signed [AW-1:0] t_scaled = $signed(t) <<< FRAC_W;
   wire signed [AW-1:0] tof_w = a - t_scaled;
   localparam integer CYCLE = CODES * PERIOD_T;
-  wire [PW:0] rounded = {1'b0, acc} + (1'b1 << (SH - 1));
-  wire [PW:0] dist_full = rounded >> SH;
+  // (P + 2^(SH-1)) >> SH == (P >> SH) + P[SH-1]: round half up as an increment.
+  wire [PW-1:0] prod = {hi, mplier};
+  wire [C_W:0] hsum = {1'b0, hi} + (mplier[0] ? {1'b0, c_used} : {(C_W+1){1'b0}});
+  wire [PW:0] dist_full = {1'b0, prod[PW-1:SH]} + prod[SH-1];
   wire dist_over = |dist_full[PW:DIST_W];
 
   always @(posedge clk) begin
@@ -128,7 +133,7 @@ module tof_distance #(
       c_current <= C_INIT;
       m_valid <= 1'b0;
       m_code <= 0; m_flags <= 0; m_tof <= 0; m_distance <= 0; m_score <= 0; m_margin <= 0;
-      a <= 0; t <= 0; k <= 0; no_tx <= 0; sat <= 0; mplier <= 0; mcand <= 0; acc <= 0;
+      a <= 0; t <= 0; k <= 0; no_tx <= 0; sat <= 0; mplier <= 0; hi <= 0;
       c_used <= 0; mcount <= 0;
     end else begin
       if (burst_valid) begin
@@ -174,14 +179,11 @@ module tof_distance #(
             end
             state <= MUL;
           end
-          acc <= 0;
-          mcand <= {{TOF_W{1'b0}}, c_used};
+          hi <= 0;
           mcount <= 0;
         end
         MUL: begin
-          if (mplier[0]) acc <= acc + mcand;
-          mcand <= mcand << 1;
-          mplier <= mplier >> 1;
+          {hi, mplier} <= {hsum, mplier[TOF_W-1:1]};  // (hi + C [lsb]) : mplier, shifted right
           if (mcount == TOF_W - 1) state <= OUT;
           mcount <= mcount + 1'b1;
           if (mcount == 0) m_tof <= mplier;
