@@ -622,6 +622,7 @@ module correlator_bank #(
     else a_addr_nx = a_addr;
   end
 
+  integer jw;
   wire [WEIGHTED_W-1:0] q_sum = (s2_first ? {WEIGHTED_W{1'b0}} : q_acc) + psh[WEIGHTED_W-1:0];
   wire [FIR_W-1:0] facc_base = s2_first ? {FIR_W{1'b0}} : facc;
 
@@ -750,8 +751,10 @@ module correlator_bank #(
             end else p_acc <= p_acc + psh[PW_W-1:0];
           end
           default: begin
-            if (s2_last) out_weighted[s2_j*WEIGHTED_W +: WEIGHTED_W] <= q_sum;
-            else q_acc <= q_sum;
+            // per-slot write enables (a variable part-select would build a 432-bit shifter)
+            for (jw = 0; jw < CODES; jw = jw + 1)
+              if (s2_last && s2_j == jw[JI_W-1:0]) out_weighted[jw*WEIGHTED_W +: WEIGHTED_W] <= q_sum;
+            if (!s2_last) q_acc <= q_sum;
           end
         endcase
       end
@@ -785,11 +788,15 @@ module correlator_bank #(
         C_Q: if (!cq_valid) begin
           cq_ar <= q_corr(ca_re); cq_ai <= q_corr(ca_im);
           cq_br <= q_corr(cb_re); cq_bi <= q_corr(cb_im);
-          out_corr_re[c_ja*CORR_W +: CORR_W] <= q_corr(ca_re);
-          out_corr_im[c_ja*CORR_W +: CORR_W] <= q_corr(ca_im);
-          if (c_has_b) begin
-            out_corr_re[c_jb*CORR_W +: CORR_W] <= q_corr(cb_re);
-            out_corr_im[c_jb*CORR_W +: CORR_W] <= q_corr(cb_im);
+          for (jw = 0; jw < CODES; jw = jw + 1) begin
+            if (c_ja == jw[JI_W-1:0]) begin
+              out_corr_re[jw*CORR_W +: CORR_W] <= q_corr(ca_re);
+              out_corr_im[jw*CORR_W +: CORR_W] <= q_corr(ca_im);
+            end
+            if (c_jb == jw[JI_W-1:0]) begin
+              out_corr_re[jw*CORR_W +: CORR_W] <= q_corr(cb_re);
+              out_corr_im[jw*CORR_W +: CORR_W] <= q_corr(cb_im);
+            end
           end
           cq_valid <= 1'b1;
           cq_two <= c_has_b;
