@@ -1,16 +1,15 @@
 # The ranging system (issue 5, docs/bitstream.md): generated system top, closed-loop Verilator
 # test of rtl/ranging_system.v, and the FPGA flow (target `bitstream`, ctest label "bitstream").
 
-set(RANGING_TB_CLK_DIV_VALUE 24)  # clocks per sample in the closed-loop testbench
-
 # The generated system files of the default configuration are in generated/default (committed).
 set(RANGING_GEN_SYSTEM ${RANGING_GEN_DEFAULT})
 set(RANGING_SYSTEM_TB_VC ${CMAKE_CURRENT_BINARY_DIR}/ranging_system_tb.vc)
 if(EXISTS ${RANGING_GEN_SYSTEM}/rtl/ranging_system.vc)
-  # The testbench's clock divider: the receiver RTL as it is must keep up (tb_ranging_system.cpp).
+  # The closed loop runs at the configuration's own clock divider (hardware.clock_hz / fs):
+  # the receiver RTL must keep up with the ADC at the real rate (tb_ranging_system.cpp).
   file(READ ${RANGING_GEN_SYSTEM}/rtl/ranging_system.vc RANGING_SYSTEM_VC_TEXT)
-  string(REGEX REPLACE "-GCLK_DIV=[^\n]+" "-GCLK_DIV=${RANGING_TB_CLK_DIV_VALUE}" RANGING_SYSTEM_VC_TEXT
-         "${RANGING_SYSTEM_VC_TEXT}")
+  string(REGEX MATCH "-GCLK_DIV=(32'd)?([0-9]+)" _clk_div_match "${RANGING_SYSTEM_VC_TEXT}")
+  set(RANGING_TB_CLK_DIV_VALUE ${CMAKE_MATCH_2})
   file(WRITE ${RANGING_SYSTEM_TB_VC} "${RANGING_SYSTEM_VC_TEXT}")
   # Regenerated parameters (ranging generate) must reach the testbench's copy.
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${RANGING_GEN_SYSTEM}/rtl/ranging_system.vc)

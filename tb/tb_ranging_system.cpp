@@ -4,9 +4,9 @@
 // is checked sample by sample against hbridge_drive; the UART line is decoded into frames and
 // every frame is checked field by field against ReceiverFixed + TofDistanceModel fed with the
 // same ADC codes, and against the true distance.
-// The system clock divider is the testbench's (RANGING_TB_CLK_DIV clocks per sample) so that
-// the receiver RTL as it is keeps up; the 5 MS/s rate at the board clock is the bitstream
-// summary's business (docs/bitstream.md).
+// The system clock divider is the configuration's (RANGING_TB_CLK_DIV = hardware.clock_hz / fs,
+// 6 at 30 MHz): the receiver must take every ADC sample at the board's real rate, or the ADC
+// interface flags an overrun (led_error), which the test asserts never happens.
 #include <gtest/gtest.h>
 
 #include <algorithm>
