@@ -173,7 +173,8 @@ module peak_detector #(
   wire [15:0] a_dig = mp ? a2_v[mi*16 +: 16] : a1_v[mi*16 +: 16];
   wire [15:0] b_dig = mp ? b2_v[mj*16 +: 16] : b1_v[mj*16 +: 16];
   wire signed [AW-1:0] prod_x = $signed({{(AW-32){1'b0}}, prod});
-  wire signed [AW-1:0] acc_sum = s2 ? acc - prod_x : acc + prod_x;
+  // one adder: acc - prod = acc + ~prod + 1
+  wire signed [AW-1:0] acc_sum = acc + (prod_x ^ {AW{s2}}) + {{(AW-1){1'b0}}, s2};
   wire d_ge0 = !acc[AW-1];
   wire d_gt0 = d_ge0 && ((acc != 0) || acc_nz);
 
