@@ -41,17 +41,20 @@
 // of 32 bits plus the carried-in column); divider registers WEIGHTED_W+3 bits; quotients as
 // above. No rounding; nothing can overflow.
 // Latency / throughput (CODES=9, 48-bit Q, 29-bit norm: NA=3, NB=2 digits): a beat takes
-// 1 + CODES + 1 + (2 NA NB + 3) [gate] + (2 NA NB + 3) [rho^2, only if gate and a candidate
-// exists] + 1 cycles <= 42; an event adds 2 + FRAC_W + 1 + 2 (SCORE_W+2) + 1 = 48 cycles, so a
-// beat with an event is done in <= 90 cycles < the 120 between the bank's outputs (DECIM 20 x
-// 6 clocks): s_ready is high whenever the bank presents a beat. s_ready stays low while a beat
-// or an event is processed and until the event is in the output register (m_ready back-
-// pressure stalls the bank; nothing is lost).
+// 1 + CODES + (2 NA NB + 3) [gate] + (2 NA NB + 3) [rho^2 test, only when the gate passes and a
+// candidate exists] + 1 = 41 cycles at most; an event adds 2 + FRAC_W + 1 + 2 (SCORE_W + 2) + 1
+// = 48 cycles, so a beat with an event is done in <= 89 cycles (measured by tb_peak_detector) <
+// the 120 between the bank's outputs (DECIM 20 x 6 clocks): s_ready is high whenever the bank
+// presents a beat. s_ready stays low while a beat or an event is processed and until the event
+// is in the output register (m_ready back-pressure stalls the bank; nothing is lost).
 // Streams: valid/ready with AXI4-Stream rules (m_* stable while m_valid && !m_ready).
 // Reset: synchronous, active high, clears the control state, the candidate and the output
 // valid; the previous-beat vector reads as zeros until a beat has been taken.
-// Resources (yosys synth_ice40, default configuration): see the header of tb_peak_detector.cpp
-// and the commit message; 1 SB_MAC16, 3 SB_RAM40_4K.
+// Resources (yosys synth_ice40 -dsp, default configuration, /work/notes/module_stat.sh):
+// 2025 SB_LUT4, 1177 DFF, 1 SB_MAC16, 3 SB_RAM40_4K. 432 DFF and ~432 LUT4 of these are the
+// beat's shift register (load / shift multiplexer); the rest is mostly the divider (5 sources
+// into its 51-bit remainder, 4 wide adders for dQ, den, |dQ| and the step), the MAC digit
+// multiplexers and accumulator, the scan comparators and the 4 candidate words.
 `default_nettype none
 
 module peak_detector #(
@@ -176,6 +179,9 @@ module peak_detector #(
   // one adder: acc - prod = acc + ~prod + 1
   wire signed [AW-1:0] acc_sum = acc + (prod_x ^ {AW{s2}}) + {{(AW-1){1'b0}}, s2};
   wire d_ge0 = !acc[AW-1];
+  // a MAC program starts: after the scan (gate) or after a passed gate with a candidate (rho^2)
+  wire m_start = (state == S_SCAN && j == LAST_J) ||
+                 (state == S_MAC && m_done && !m_mode && d_ge0 && min_ok && c_valid);
   wire d_gt0 = d_ge0 && ((acc != 0) || acc_nz);
 
   // ---------------------------------------------------------------- event / divider
@@ -258,13 +264,13 @@ module peak_detector #(
       // MAC pipeline control and accumulator
       v2 <= v1; s2 <= s1; e2 <= e1; fin2 <= fin1;
       v1 <= 1'b0; fin1 <= 1'b0;
-      if (v2) begin
-        if (e2) begin
-          acc <= acc_sum >>> 16;
-          acc_nz <= acc_nz | (acc_sum[15:0] != 16'd0);
-        end else begin
-          acc <= acc_sum;
-        end
+      // one write site per register: clear = synchronous reset, else one 2:1 choice
+      if (m_start) begin
+        acc <= {AW{1'b0}};
+        acc_nz <= 1'b0;
+      end else if (v2) begin
+        acc <= e2 ? acc_sum >>> 16 : acc_sum;
+        acc_nz <= acc_nz | (e2 && acc_sum[15:0] != 16'd0);
       end
       m_done <= fin2;
       if (m_run) begin
@@ -310,7 +316,6 @@ module peak_detector #(
             state <= S_MAC;
             m_run <= 1'b1; m_mode <= 1'b0;
             mk <= 0; mi <= 0; mp <= 1'b0;
-            acc <= 0; acc_nz <= 1'b0;
           end
         end
         S_MAC: if (m_done) begin
@@ -319,7 +324,6 @@ module peak_detector #(
             if (d_ge0 && min_ok && c_valid) begin
               m_run <= 1'b1; m_mode <= 1'b1;
               mk <= 0; mi <= 0; mp <= 1'b0;
-              acc <= 0; acc_nz <= 1'b0;
             end else begin
               state <= S_DECIDE;
             end

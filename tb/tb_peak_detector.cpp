@@ -485,14 +485,17 @@ TEST(PeakDetectorRtl, DividerAndCrossProductEdgeCases) {
     beats.push_back(b);
   };
   // A peak (qp, q, qn) of code c with norm nb, second code q2, then quiet beats past the holdoff.
+  // gated_tail: the quiet beats pass the gate (rho^2 ~ 0.6) but not the candidate's rho^2 test, so
+  // the event leaves on a beat that ran both MAC programs (the longest beat).
   auto peak = [&](std::uint64_t qp, std::uint64_t q, std::uint64_t qn, std::uint64_t q2, std::uint64_t nb,
-                  std::uint64_t nc) {
+                  std::uint64_t nc, bool gated_tail = false) {
     const int c = static_cast<int>(rng() % static_cast<std::uint64_t>(codes));
     const int c2 = (c + 1 + static_cast<int>(rng() % static_cast<std::uint64_t>(codes - 1))) % codes;
     beat(c, qp, c2, 0, nmax);
     beat(c, q, c2, q2, nb);
     beat(c, qn, c2, 0, nc);
-    for (int i = 0; i < ref.holdoff() / static_cast<int>(step) + 3; ++i) beat(c, 0, c2, 0, 1);
+    const std::uint64_t tail = gated_tail ? (ref.threshold() * 5 / 4) * ref.min_norm() : 0;
+    for (int i = 0; i < ref.holdoff() / static_cast<int>(step) + 3; ++i) beat(c, 0, c2, tail, ref.min_norm());
   };
   const std::uint64_t norms[] = {ref.min_norm(), 12345, nmax};
   for (std::uint64_t nb : norms) {
@@ -500,7 +503,7 @@ TEST(PeakDetectorRtl, DividerAndCrossProductEdgeCases) {
     const std::uint64_t qs[] = {nb * cap + nb - 1, nb * (cap + 1), nb * cap - 1, nb * (cap + 1) - 1};
     for (std::uint64_t q : qs) {
       if (q > qmax) continue;
-      peak(q / 2, q, q / 3, q - 1, nb, nmax);
+      peak(q / 2, q, q / 3, q - 1, nb, nmax, true);
       peak(q / 2, q, q / 3, nb * cap - 1, nb, nmax);
       peak(q / 2, q, q / 3, nb * (cap + 1) - 1 <= q ? nb * (cap + 1) - 1 : q / 2, nb, nmax);
     }
