@@ -108,7 +108,9 @@ std::vector<HwModuleParams> hardware_parameters(const ReceiverDesign& d) {
                 scalar("ACC_W", c.bandpass.acc_bits),
                 scalar("ROUNDING", rounding_code(c.bandpass.rounding)),
                 scalar("SATURATE", c.bandpass.overflow == Overflow::Saturate ? 1 : 0),
-                packed("COEFS", coefs, c.bandpass.coef_bits)};
+                packed("COEFS", coefs, c.bandpass.coef_bits),
+                // clocks per input sample: how many sections share a multiplier
+                scalar("SAMPLE_CYCLES", c.sample_cycles())};
   out.push_back(sos);
 
   const int time_w = 40;

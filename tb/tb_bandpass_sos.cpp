@@ -329,7 +329,7 @@ ParamList read_vc(const std::string& path) {
 int rounding_code(Rounding r) { return r == Rounding::Truncate ? 0 : r == Rounding::RoundHalfUp ? 1 : 2; }
 
 // The module parameters for a model configuration (what the generator does for bandpass_sos).
-ParamList params_for(const BandpassFixed& m) {
+ParamList params_for(const BandpassFixed& m, int sample_cycles) {
   const BandpassFixedConfig& c = m.config();
   std::vector<std::int64_t> coefs;
   for (const auto& s : m.coefficients()) coefs.insert(coefs.end(), s.begin(), s.end());
@@ -342,7 +342,8 @@ ParamList params_for(const BandpassFixed& m) {
           {"ACC_W", std::to_string(c.acc_bits)},
           {"ROUNDING", std::to_string(rounding_code(c.rounding))},
           {"SATURATE", c.overflow == Overflow::Saturate ? "1" : "0"},
-          {"COEFS", verilog_packed(coefs, c.coef_bits)}};
+          {"COEFS", verilog_packed(coefs, c.coef_bits)},
+          {"SAMPLE_CYCLES", std::to_string(sample_cycles)}};
 }
 
 std::string rtl_path() { return std::string(RANGING_SOURCE_DIR) + "/rtl/bandpass_sos.v"; }
@@ -451,7 +452,7 @@ TEST(BandpassSosRtl, GeneratedParametersAreTheModels) {
   // same configuration. Both must describe the same filter for the comparison to mean anything.
   const BandpassFixed m(default_design().filter, default_design().config.bandpass);
   const ParamList vc = read_vc(vc_path());
-  const ParamList mine = params_for(m);
+  const ParamList mine = params_for(m, default_design().config.sample_cycles());
   ASSERT_EQ(vc.size(), mine.size());
   for (std::size_t i = 0; i < vc.size(); ++i) {
     EXPECT_EQ(vc[i].first, mine[i].first);
@@ -674,6 +675,7 @@ TEST(BandpassSosRtl, IcarusBitExactAcrossModes) {
     BandpassFixedConfig cfg;
     bool from_vc;
     bool min_acc;
+    int sample_cycles = 6;  // < 6: the one-multiplier-per-section architecture
   };
   auto cfg = [&](Rounding r, Overflow o, int in_bits, int coef_frac, int data_bits, int data_frac) {
     BandpassFixedConfig c = d.config.bandpass;
@@ -693,6 +695,7 @@ TEST(BandpassSosRtl, IcarusBitExactAcrossModes) {
       {"conv_wrap_default_filter_coef10", &d.filter, cfg(Rounding::Convergent, Overflow::Wrap, 12, 10, 13, 12), false, true},
       {"trunc_sat_four_sections", &four, cfg(Rounding::Truncate, Overflow::Saturate, 12, 14, 13, 12), false, true},
       {"halfup_wrap_in10_coef13", &d.filter, cfg(Rounding::RoundHalfUp, Overflow::Wrap, 10, 13, 16, 14), false, true},
+      {"default_per_section_mac", &d.filter, d.config.bandpass, false, false, 4},
   };
   int seed = 1;
   long total = 0;
@@ -729,7 +732,7 @@ TEST(BandpassSosRtl, IcarusBitExactAcrossModes) {
       EXPECT_TRUE(differs) << var.name << ": no exact tie exercised";
     }
 
-    const ParamList params = var.from_vc ? read_vc(vc_path()) : params_for(m);
+    const ParamList params = var.from_vc ? read_vc(vc_path()) : params_for(m, var.sample_cycles);
     const CmdResult l = lint(params);
     EXPECT_EQ(l.rc, 0) << var.name << ": " << l.output;
     EXPECT_EQ(l.output, "") << var.name;

@@ -51,7 +51,8 @@ module receiver_top (
     .ACC_W(32'd40),
     .ROUNDING(32'd1),
     .SATURATE(32'd1),
-    .COEFS(400'h3e0f842afa5c000005a43cd2894ffcf10000030f3a7a8822fc18000003e838838c68fbd80000042838088b82fc04000003fc)
+    .COEFS(400'h3e0f842afa5c000005a43cd2894ffcf10000030f3a7a8822fc18000003e838838c68fbd80000042838088b82fc04000003fc),
+    .SAMPLE_CYCLES(32'd6)
   ) u_filter (
     .clk(clk), .rst(rst),
     .s_data(s_axis_tdata), .s_valid(s_axis_tvalid), .s_ready(s_axis_tready),

@@ -18,6 +18,7 @@ struct ReceiverConfig {
   static constexpr std::int64_t SOS_ROUNDING = 1;
   static constexpr std::int64_t SOS_SATURATE = 1;
   static constexpr std::int64_t SOS_COEFS[25] = {1020, 0, -1020, -29822, 14344, 1064, 0, -1064, -29592, 14467, 1000, 0, -1000, -30686, 14970, 783, 0, -783, -30385, 15570, 1444, 0, -1444, -31702, 15887};
+  static constexpr std::int64_t SOS_SAMPLE_CYCLES = 18;
   // correlator_bank
   static constexpr std::int64_t BANK_DATA_W = 16;
   static constexpr std::int64_t BANK_DATA_FRAC = 14;
