@@ -27,22 +27,26 @@
 // Architecture: a front end and a back end with three engines sharing one multiplier.
 //   Front end (6 clocks per input sample): one signed DATA_W x max(LO_W,DATA_W) multiplier
 //     (registered operands and product) does y*cos, y*-sin, y*y and y_old*y_old; the B and y
-//     histories are memories. At a decimation point the same cycle writes Bd = acc into the
-//     Bd history and pushes E into a 2-entry queue (a hand-off costs no extra cycle unless
-//     the back end is more than one output behind; then the front end waits).
+//     histories are memories; E += y^2 and E -= y_old^2 share one adder. After the last
+//     input of a decimation group, the hand-off clock (which also accepts the next input,
+//     so it costs no extra cycle unless the back end is more than one output behind; then
+//     the front end waits) writes Bd = acc into the Bd history and pushes E into a 2-entry
+//     queue.
 //   Back end: ONE unsigned 16x16 multiplier (registered limb operands, registered product)
 //     in sign-magnitude: every wide operand is split into 16-bit limbs of its magnitude, the
-//     limb product is shifted by 16 (la+lb) and added or subtracted. Exact integer arithmetic,
+//     limb product is shifted by 16 (la+lb) and added or subtracted (one adder: the product
+//     is inverted and the carry-in set when negative). Exact integer arithmetic,
 //     so the order of the partial products does not change any result. Three clients, in
 //     priority order W > SQ > FIR, each issuing one limb product per clock:
 //     FIR (stage A): per output, lane re then lane im, TAPS taps, ceil(DEC_W/16) x
 //       ceil(TAP_W/16) limb products per tap, from the Bd history (TAPS+1 deep, so the next
 //       Bd can be written while a FIR runs) into one FIR_W accumulator; F_re is quantized
 //       while the first im product is accumulated, F_im after the last.
-//     Combiner (no multiplier): per output, rounds of two codes; each round reads the CHIPS
-//       taps F[k - (CHIPS-1-m) CHIP_STEP] from the F history (one per clock) into four
-//       COMB_W accumulators (re, im of both codes), then quantizes them into Cq registers
-//       (and the m_corr outputs): CHIPS + 2 clocks per round.
+//     Combiner (no multiplier): per output, one round per code; each round reads the CHIPS
+//       taps F[k - (CHIPS-1-m) CHIP_STEP] from the F history (one per clock) into two
+//       COMB_W accumulators (re, im; C +- F on one adder each), then quantizes them into
+//       the Cq registers (and code j's m_corr slots) and clears them: CHIPS + 2 clocks per
+//       round, (CHIPS + 2) CODES per output (81 at the defaults, within the 120).
 //     SQ: Re^2 + Im^2 per code (2 ceil(CORR_W/16)^2 limb products) into P.
 //     W: P * w_j (ceil(2 CORR_W/16) x ceil(WEIGHT_W/16) limb products), written straight
 //       into code j's slot of m_weighted.
@@ -55,7 +59,7 @@
 //   end sets the pace (the front end waits at a decimation point). 6 clocks at the defaults
 //   (tested: one input every 6 clocks is never refused).
 // Latency: last input of a decimation group to m_valid: about 2 TAPS ceil(DEC_W/16)
-//   ceil(TAP_W/16) + 4 (FIR) + (CHIPS+2) ceil(CODES/2) + 8 clocks when idle (~150 at the
+//   ceil(TAP_W/16) + 5 (FIR) + (CHIPS+2) CODES + 8 clocks when idle (~175 at the
 //   defaults), more when the previous output's SQ/W work overlaps.
 // Multipliers (synth_ice40 -dsp): 2 SB_MAC16 at the defaults (front 16x16 signed, back 16x16
 //   unsigned). Memories (synchronous read, no reset, EBR): B history PERIOD x 2 MIX_W,
@@ -64,8 +68,10 @@
 //   a fill flag/counter per history masks entries not written since reset to zero, so after
 //   reset the outputs equal a fresh model's without a clearing pass.
 // Resources (yosys synth_ice40 -dsp, defaults, /work/notes/module_stat.sh correlator_bank):
-//   2 SB_MAC16, 13 SB_RAM40_4K, 2901 SB_LUT4, 1943 DFF (of which 288 are the m_corr_re/im
-//   debug registers, 432 the m_weighted bus). Was 7 / 13 / 4217 / 2520 before this design.
+//   2 SB_MAC16, 13 SB_RAM40_4K, 1847 SB_LUT4, 1860 DFF (of which 288 are the m_corr_re/im
+//   debug registers, 432 the m_weighted bus; flattened with m_corr/m_chip unconnected:
+//   1836 SB_LUT4, 1532 DFF). Was 7 / 13 / 4217 / 2520 before this design, 2 / 13 / 2901 /
+//   1943 with two codes per combiner round and separate add/subtract paths.
 //
 // Streams: s_* one beat per input sample (s_ready high only when the front end is idle);
 // m_* one beat per decimated output; data stable while m_valid && !m_ready; the back end
@@ -155,12 +161,10 @@ module correlator_bank #(
   localparam integer XW      = imax(imax(FIR_W, PW_W), imax(WEIGHTED_W, 2 * LW)) + 1;
   localparam integer TAPM_W  = NTB * LW;
   localparam integer WTP_W   = NW * LW;
-  localparam integer ROUNDS  = (CODES + 1) / 2;
   // index widths
   localparam integer TI_W    = wbits(TAPS + 1);
   localparam integer CI_W    = wbits(CHIPS);
-  localparam integer JI_W    = wbits(CODES + 1);
-  localparam integer RI_W    = wbits(ROUNDS);
+  localparam integer JI_W    = wbits(CODES);
   localparam integer DIST_W  = wbits(FN + 1);
   localparam integer LBA_W   = wbits(NBA);
   localparam integer LTB_W   = wbits(NTB);
@@ -193,10 +197,8 @@ module correlator_bank #(
   localparam [FA_W:0] FN_A = FN_N_I[FA_W:0];
   localparam integer C_LAST_I = CHIPS - 1;
   localparam [CI_W-1:0] C_LAST = C_LAST_I[CI_W-1:0];
-  localparam integer R_LAST_I = ROUNDS - 1;
-  localparam [RI_W-1:0] R_LAST = R_LAST_I[RI_W-1:0];
-  localparam integer CODES_I = CODES;
-  localparam [JI_W-1:0] CODES_N = CODES_I[JI_W-1:0];
+  localparam integer J_LAST_I = CODES - 1;
+  localparam [JI_W-1:0] J_LAST = J_LAST_I[JI_W-1:0];
   localparam integer NBA_L_I = NBA - 1;
   localparam [LBA_W-1:0] NBA_L = NBA_L_I[LBA_W-1:0];
   localparam integer NTB_L_I = NTB - 1;
@@ -390,13 +392,14 @@ module correlator_bank #(
   reg [BA_W-1:0]    a_addr_nx;
   wire [BA_W-1:0] bd_wptr_next = (bd_wptr == BD_LAST) ? {BA_W{1'b0}} : bd_wptr + 1'b1;
   wire hand_ok = !bd_pend && (eq_n != 2'd2);
-  wire hand = hand_ok && ((fe_state == FE_M5 && dphase == D_LAST) || fe_state == FE_HAND);
+  wire hand = hand_ok && (fe_state == FE_HAND);
   always @(posedge clk) begin
     if (hand) bd_mem[bd_wptr_next] <= {acc_re, acc_im};
     bd_rd <= bd_mem[a_addr_nx];
   end
 
-  assign s_ready = (fe_state == FE_IDLE);
+  // FE_HAND (after the last sample of a group) accepts the next sample when the hand-off happens
+  assign s_ready = (fe_state == FE_IDLE) || hand;
   wire accept = s_valid && s_ready;
   wire [YA_W-1:0] y_ptr_next = (y_ptr == Y_LAST) ? {YA_W{1'b0}} : y_ptr + 1'b1;
   wire [MIX_W-1:0] q_mix_fp = q_mix(fp);
@@ -404,11 +407,13 @@ module correlator_bank #(
   wire signed [MIX_W-1:0]  b_old_re = b_full ? b_rd[2*MIX_W-1:MIX_W] : {MIX_W{1'b0}};
   wire signed [MIX_W-1:0]  b_old_im = b_full ? b_rd[MIX_W-1:0] : {MIX_W{1'b0}};
   // y^2 and y_old^2 are non-negative and below 2^(2 DATA_W-2) + 1.
+  // E + y^2 (FE_M4) and E - y_old^2 (FE_M5) on one adder: E + (fp ^ -sub) + sub
+  wire e_sub = (fe_state == FE_M5);
   /* verilator lint_off UNUSEDSIGNAL */
-  wire [EX_W-1:0] energy_add = {{(EX_W-ENERGY_W){1'b0}}, energy} + {{(EX_W-FP_W){1'b0}}, fp};
-  wire [EX_W-1:0] energy_sub = {{(EX_W-ENERGY_W){1'b0}}, energy} - {{(EX_W-FP_W){1'b0}}, fp};
+  wire [EX_W:0] energy_s = {{(EX_W-ENERGY_W){1'b0}}, energy, 1'b1} +
+                           {{{(EX_W-FP_W){1'b0}}, fp} ^ {EX_W{e_sub}}, e_sub};
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [ENERGY_W-1:0] energy_new = (fe_state == FE_M5) ? energy_sub[ENERGY_W-1:0] : energy;
+  wire [ENERGY_W-1:0] energy_new = energy;  // final in FE_HAND
 
   always @(posedge clk) begin
     if (rst) begin
@@ -441,12 +446,14 @@ module correlator_bank #(
         bd_pend <= 1'b1;
       end
       case (fe_state)
-        FE_IDLE: if (accept) begin
+        FE_IDLE, FE_HAND: if (accept) begin
           y_r <= s_data;
           fa <= s_data;
           fb <= lo_rom(LO_C, phase);
           y_ptr <= y_ptr_next;  // y_rd holds y_mem[y_ptr] from FE_M2 on
           fe_state <= FE_M1;
+        end else if (hand) begin
+          fe_state <= FE_IDLE;
         end
         FE_M1: begin
           fp <= fa * fb;  // y cos
@@ -468,7 +475,7 @@ module correlator_bank #(
         end
         FE_M4: begin  // memories written this cycle (fe_write)
           fp <= fa * fb;  // y_old^2
-          energy <= energy_add[ENERGY_W-1:0];
+          energy <= energy_s[ENERGY_W:1];
           acc_re <= acc_re + {{(DEC_W-MIX_W){mix_re[MIX_W-1]}}, mix_re}
                            - {{(DEC_W-MIX_W){b_old_re[MIX_W-1]}}, b_old_re};
           acc_im <= acc_im + {{(DEC_W-MIX_W){mix_im[MIX_W-1]}}, mix_im}
@@ -484,16 +491,15 @@ module correlator_bank #(
           fe_state <= FE_M5;
         end
         FE_M5: begin
-          energy <= energy_sub[ENERGY_W-1:0];
+          energy <= energy_s[ENERGY_W:1];
           if (dphase == D_LAST) begin
             dphase <= 0;
-            fe_state <= hand ? FE_IDLE : FE_HAND;
+            fe_state <= FE_HAND;
           end else begin
             dphase <= dphase + 1'b1;
             fe_state <= FE_IDLE;
           end
         end
-        FE_HAND: if (hand) fe_state <= FE_IDLE;
         default: fe_state <= FE_IDLE;
       endcase
     end
@@ -531,22 +537,22 @@ module correlator_bank #(
   wire signed [DEC_W-1:0] bd_lane = a_lane ? bd_rd[DEC_W-1:0] : bd_rd[2*DEC_W-1:DEC_W];
   wire [DEC_W-1:0] bd_mag = bd_lane[DEC_W-1] ? -bd_lane : bd_lane;
   wire [NBA*LW-1:0] bd_mag_p = {{(NBA*LW-DEC_W){1'b0}}, bd_mag};
-  wire [LW-1:0] a_opa = (a_i < a_cnt) ? bd_mag_p[a_la*LW +: LW] : {LW{1'b0}};
+  wire a_ok = (a_i < a_cnt);  // Bd entry written since reset (else it reads as zero)
+  wire [LW-1:0] a_opa = a_ok ? bd_mag_p[a_la*LW +: LW] : {LW{1'b0}};
   wire [TAPM_W:0] tap_sm = tap_rom(a_i);
   wire [TAPM_W-1:0] tap_mag = tap_sm[TAPM_W-1:0];
   wire [LW-1:0] a_opb = tap_mag[a_lb*LW +: LW];
-  wire a_neg = bd_lane[DEC_W-1] ^ tap_sm[TAPM_W];
+  wire a_neg = a_ok && (bd_lane[DEC_W-1] ^ tap_sm[TAPM_W]);
 
   // ---- combiner
   localparam [1:0] C_IDLE = 2'd0, C_RUN = 2'd1, C_DRAIN = 2'd2, C_Q = 2'd3;
   reg [1:0]        c_state;
   reg [CI_W-1:0]   c_m, c_m1;
   reg              c_iss1, c_dv1;
-  reg [RI_W-1:0]   c_round;
-  reg [JI_W-1:0]   c_ja;
+  reg [JI_W-1:0]   c_j;
   reg [FA_W-1:0]   f_wptr, f_rptr, f_old;
   reg [DIST_W-1:0] f_cnt, f_dist;
-  reg [CA_W-1:0]   ca_re, ca_im, cb_re, cb_im;
+  reg [CA_W-1:0]   ca_re, ca_im;
   reg [2*CHIP_W-1:0] f_mem [0:FN-1];
   reg [2*CHIP_W-1:0] f_rd;
   wire [FA_W-1:0] f_wptr_next = (f_wptr == F_LAST) ? {FA_W{1'b0}} : f_wptr + 1'b1;
@@ -559,10 +565,17 @@ module correlator_bank #(
   wire signed [CHIP_W-1:0] f_rd_im = f_rd[CHIP_W-1:0];
   wire signed [CA_W-1:0] f_re_x = {{(CA_W-CHIP_W){f_rd_re[CHIP_W-1]}}, f_rd_re};
   wire signed [CA_W-1:0] f_im_x = {{(CA_W-CHIP_W){f_rd_im[CHIP_W-1]}}, f_rd_im};
-  wire [JI_W-1:0] c_jb = c_ja + 1'b1;
-  wire c_has_b = (c_jb < CODES_N);
-  wire sa = code_rom(c_ja, c_m1);
-  wire sb = c_has_b ? code_rom(c_jb, c_m1) : 1'b1;
+  // C += s F as one adder: C + (F ^ -neg) + neg, the carry-in entering as a low bit;
+  // an entry not written since reset reads as zero.
+  wire c_neg = !code_rom(c_j, c_m1);
+  wire [CA_W-1:0] f_re_m = (c_dv1 ? f_re_x : {CA_W{1'b0}}) ^ {CA_W{c_neg}};
+  wire [CA_W-1:0] f_im_m = (c_dv1 ? f_im_x : {CA_W{1'b0}}) ^ {CA_W{c_neg}};
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [CA_W:0] ca_re_s = {ca_re, 1'b1} + {f_re_m, c_neg};
+  wire [CA_W:0] ca_im_s = {ca_im, 1'b1} + {f_im_m, c_neg};
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [CORR_W-1:0] cq_re_n = q_corr(ca_re);
+  wire [CORR_W-1:0] cq_im_n = q_corr(ca_im);
   wire b_start;
   wire f_write = b_start;
   always @(posedge clk) begin
@@ -571,10 +584,10 @@ module correlator_bank #(
   end
 
   // ---- SQ and W engines
-  reg [CORR_W-1:0] cq_ar, cq_ai, cq_br, cq_bi;
-  reg              cq_valid, cq_two;
+  reg [CORR_W-1:0] cq_re, cq_im;
+  reg              cq_valid;
   reg [JI_W-1:0]   cq_j;
-  reg              sq_c, sq_p;
+  reg              sq_p;
   reg [LC_W-1:0]   sq_la, sq_lb;
   reg [PW_W-1:0]   p_acc, p_w;
   reg              pw_valid;
@@ -582,12 +595,11 @@ module correlator_bank #(
   reg [LP_W-1:0]   w_la;
   reg [LWT_W-1:0]  w_lb;
   reg [WEIGHTED_W-1:0] q_acc;
-  wire [CORR_W-1:0] sq_val = sq_c ? (sq_p ? cq_bi : cq_br) : (sq_p ? cq_ai : cq_ar);
+  wire [CORR_W-1:0] sq_val = sq_p ? cq_im : cq_re;
   wire [CORR_W-1:0] sq_mag = sq_val[CORR_W-1] ? -sq_val : sq_val;
   wire [NC*LW-1:0]  sq_mag_p = {{(NC*LW-CORR_W){1'b0}}, sq_mag};
   wire sq_first = !sq_p && (sq_la == {LC_W{1'b0}}) && (sq_lb == {LC_W{1'b0}});
   wire sq_last  = sq_p && (sq_la == NC_L) && (sq_lb == NC_L);
-  wire sq_final = sq_last && (sq_c == cq_two);
   // P_w is written 2 clocks after a code's last SQ product issues: it may issue only if the
   // W engine will have read the previous P_w by then.
   wire sq_guard = (!(s1_v && s1_cl == CL_SQ && s1_last) || NWOP <= 1) &&
@@ -624,6 +636,10 @@ module correlator_bank #(
   integer jw;
   wire [WEIGHTED_W-1:0] q_sum = (s2_first ? {WEIGHTED_W{1'b0}} : q_acc) + psh[WEIGHTED_W-1:0];
   wire [FIR_W-1:0] facc_base = s2_first ? {FIR_W{1'b0}} : facc;
+  // +-|product| as one adder: base + (p ^ -neg) + neg, the carry-in entering as a low bit
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [FIR_W:0] facc_s = {facc_base, 1'b1} + {psh[FIR_W-1:0] ^ {FIR_W{s2_neg}}, s2_neg};
+  /* verilator lint_on UNUSEDSIGNAL */
 
   always @(posedge clk) begin
     if (rst) begin
@@ -634,11 +650,11 @@ module correlator_bank #(
       a_busy <= 1'b0; a_lane <= 1'b0; a_base <= 0; a_addr <= 0; a_cnt <= 0; a_i <= 0;
       a_la <= 0; a_lb <= 0; facc <= 0; fq_pend <= 1'b0; fq_lane <= 1'b0;
       fres_re <= 0; fres_im <= 0; fres_valid <= 1'b0;
-      c_state <= C_IDLE; c_m <= 0; c_m1 <= 0; c_iss1 <= 1'b0; c_dv1 <= 1'b0; c_round <= 0;
-      c_ja <= 0; f_wptr <= F_LAST; f_rptr <= 0; f_old <= 0; f_cnt <= 0; f_dist <= 0;
-      ca_re <= 0; ca_im <= 0; cb_re <= 0; cb_im <= 0;
-      cq_ar <= 0; cq_ai <= 0; cq_br <= 0; cq_bi <= 0; cq_valid <= 1'b0; cq_two <= 1'b0;
-      cq_j <= 0; sq_c <= 1'b0; sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
+      c_state <= C_IDLE; c_m <= 0; c_m1 <= 0; c_iss1 <= 1'b0; c_dv1 <= 1'b0;
+      c_j <= 0; f_wptr <= F_LAST; f_rptr <= 0; f_old <= 0; f_cnt <= 0; f_dist <= 0;
+      ca_re <= 0; ca_im <= 0;
+      cq_re <= 0; cq_im <= 0; cq_valid <= 1'b0;
+      cq_j <= 0; sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
       p_acc <= 0; p_w <= 0; pw_valid <= 1'b0; pw_j <= 0; w_la <= 0; w_lb <= 0; q_acc <= 0;
       b_busy <= 1'b0; m_valid_r <= 1'b0;
       out_energy <= 0; out_index <= {TIME_W{1'b1}};  // + DECIM = DECIM-1 at the first output
@@ -667,19 +683,13 @@ module correlator_bank #(
         ma <= sq_mag_p[sq_la*LW +: LW];
         mb <= sq_mag_p[sq_lb*LW +: LW];
         s1_cl <= CL_SQ; s1_first <= sq_first; s1_last <= sq_last; s1_neg <= 1'b0;
-        s1_sh <= SH_ZERO + sq_la + sq_lb; s1_j <= cq_j + {{(JI_W-1){1'b0}}, sq_c};
+        s1_sh <= SH_ZERO + sq_la + sq_lb; s1_j <= cq_j;
         if (sq_lb == NC_L) begin
           sq_lb <= 0;
           if (sq_la == NC_L) begin
             sq_la <= 0;
             sq_p <= !sq_p;
-            if (sq_p) begin
-              sq_c <= !sq_c;
-              if (sq_final) begin
-                sq_c <= 1'b0;
-                cq_valid <= 1'b0;
-              end
-            end
+            if (sq_p) cq_valid <= 1'b0;
           end else begin
             sq_la <= sq_la + 1'b1;
           end
@@ -735,7 +745,7 @@ module correlator_bank #(
       if (s2_v) begin
         case (s2_cl)
           CL_A: begin
-            facc <= s2_neg ? facc_base - psh[FIR_W-1:0] : facc_base + psh[FIR_W-1:0];
+            facc <= facc_s[FIR_W:1];
             if (s2_last) begin
               fq_pend <= 1'b1;
               fq_lane <= s2_lane;
@@ -761,17 +771,8 @@ module correlator_bank #(
       // ---------------- combiner
       c_iss1 <= 1'b0;
       if (c_iss1) begin
-        if (c_m1 == {CI_W{1'b0}}) begin
-          ca_re <= c_dv1 ? (sa ? f_re_x : -f_re_x) : {CA_W{1'b0}};
-          ca_im <= c_dv1 ? (sa ? f_im_x : -f_im_x) : {CA_W{1'b0}};
-          cb_re <= c_dv1 ? (sb ? f_re_x : -f_re_x) : {CA_W{1'b0}};
-          cb_im <= c_dv1 ? (sb ? f_im_x : -f_im_x) : {CA_W{1'b0}};
-        end else if (c_dv1) begin
-          ca_re <= sa ? ca_re + f_re_x : ca_re - f_re_x;
-          ca_im <= sa ? ca_im + f_im_x : ca_im - f_im_x;
-          cb_re <= sb ? cb_re + f_re_x : cb_re - f_re_x;
-          cb_im <= sb ? cb_im + f_im_x : cb_im - f_im_x;
-        end
+        ca_re <= ca_re_s[CA_W:1];
+        ca_im <= ca_im_s[CA_W:1];
       end
       case (c_state)
         C_RUN: begin
@@ -785,27 +786,23 @@ module correlator_bank #(
         end
         C_DRAIN: c_state <= C_Q;  // the last tap is accumulated this clock
         C_Q: if (!cq_valid) begin
-          cq_ar <= q_corr(ca_re); cq_ai <= q_corr(ca_im);
-          cq_br <= q_corr(cb_re); cq_bi <= q_corr(cb_im);
-          for (jw = 0; jw < CODES; jw = jw + 1) begin
-            if (c_ja == jw[JI_W-1:0]) begin
-              out_corr_re[jw*CORR_W +: CORR_W] <= q_corr(ca_re);
-              out_corr_im[jw*CORR_W +: CORR_W] <= q_corr(ca_im);
+          // quantize code c_j, clear the accumulators for the next code
+          cq_re <= cq_re_n;
+          cq_im <= cq_im_n;
+          ca_re <= {CA_W{1'b0}};
+          ca_im <= {CA_W{1'b0}};
+          for (jw = 0; jw < CODES; jw = jw + 1)
+            if (c_j == jw[JI_W-1:0]) begin
+              out_corr_re[jw*CORR_W +: CORR_W] <= cq_re_n;
+              out_corr_im[jw*CORR_W +: CORR_W] <= cq_im_n;
             end
-            if (c_jb == jw[JI_W-1:0]) begin
-              out_corr_re[jw*CORR_W +: CORR_W] <= q_corr(cb_re);
-              out_corr_im[jw*CORR_W +: CORR_W] <= q_corr(cb_im);
-            end
-          end
           cq_valid <= 1'b1;
-          cq_two <= c_has_b;
-          cq_j <= c_ja;
-          sq_c <= 1'b0; sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
-          if (c_round == R_LAST) begin
+          cq_j <= c_j;
+          sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
+          if (c_j == J_LAST) begin
             c_state <= C_IDLE;
           end else begin
-            c_round <= c_round + 1'b1;
-            c_ja <= c_jb + 1'b1;
+            c_j <= c_j + 1'b1;
             c_m <= 0;
             f_rptr <= f_old;
             f_dist <= DIST0;
@@ -830,8 +827,7 @@ module correlator_bank #(
         f_old <= f_oldest;
         f_dist <= DIST0;
         c_m <= 0;
-        c_round <= 0;
-        c_ja <= 0;
+        c_j <= 0;
         c_state <= C_RUN;
       end
       if (b_done) begin
