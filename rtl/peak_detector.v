@@ -68,8 +68,9 @@ module peak_detector #(
   input  wire clk, rst,
   input  wire s_valid, output wire s_ready,
   // s_energy[ENERGY_SHIFT-1:0] is not needed (only norm = E >> ENERGY_SHIFT is used)
+  input  wire [WEIGHTED_W-1:0] s_weighted, input wire s_last,
   /* verilator lint_off UNUSEDSIGNAL */
-  input  wire [CODES*WEIGHTED_W-1:0] s_weighted, input wire [ENERGY_W-1:0] s_energy,
+  input  wire [ENERGY_W-1:0] s_energy,
   /* verilator lint_on UNUSEDSIGNAL */
   input  wire [TIME_W-1:0] s_index,
   output wire m_valid, input wire m_ready,
@@ -91,8 +92,6 @@ module peak_detector #(
   localparam integer CW    = $clog2(KM + 1);
   localparam integer ARR_W = TIME_W + FRAC_W + 1;
   localparam integer FR_W  = FRAC_W + 2;                          // signed fraction
-  localparam integer CODES_I = CODES;
-  localparam [JB-1:0] LAST_J = CODES_I[JB-1:0] - 1'b1;
   localparam integer HOLDOFF_I = HOLDOFF;
   localparam [TIME_W-1:0] HOLD_T = {{(TIME_W-32){1'b0}}, HOLDOFF_I[31:0]};  // TIME_W >= 32
   localparam [SCORE_W-1:0] CAP = {SCORE_W{1'b1}};
@@ -107,25 +106,27 @@ module peak_detector #(
   localparam [KW-1:0] NB_K = NB_I[KW-1:0];
   localparam [IW-1:0] NA_LAST = NA_I[IW-1:0] - 1'b1;
 
-  localparam [3:0] S_IDLE = 4'd0, S_SCAN = 4'd1, S_MAC = 4'd2, S_DECIDE = 4'd3,
+  localparam [3:0] S_IDLE = 4'd0, S_MAC = 4'd2, S_DECIDE = 4'd3,
                    S_P0 = 4'd4, S_P1 = 4'd5, S_DIV = 4'd6, S_NEXT = 4'd7, S_OUT = 4'd8;
   reg [3:0] state;
 
-  // ---------------------------------------------------------------- input beat and scan
-  reg [CODES*QW-1:0] q_r;            // shifts down one code per scan clock
+  // ---------------------------------------------------------------- input beats and scan
   reg [NW-1:0]       nrm;            // norm = E >> ENERGY_SHIFT
   reg [TIME_W-1:0]   n_r;
   reg [JB-1:0]       j;
   reg [JB-1:0]       best;
   reg [QW-1:0]       best_q, second;
-  reg                par, prev_ok;   // memory half of this beat; a previous beat exists
-  wire [QW-1:0] head = q_r[QW-1:0];
+  reg                par, prev_ok;   // memory half of this group; a previous group exists
+  wire [QW-1:0] head = s_weighted;
+  wire take = s_valid && state == S_IDLE;   // a beat is accepted
+  wire first = (j == {JB{1'b0}});
+  wire gt_best = head > best_q, gt_second = head > second;
 
   // previous / current beat's Q vectors (ping-pong halves of one memory -> EBR)
   reg [QW-1:0] pmem [0:(2 << JB)-1];
   reg [QW-1:0] p_rd;
   always @(posedge clk) begin
-    if (state == S_SCAN) pmem[{par, j}] <= head;
+    if (take) pmem[{par, j}] <= head;
     if (state == S_MAC) p_rd <= pmem[{~par, best}];
   end
 
@@ -180,7 +181,7 @@ module peak_detector #(
   wire signed [AW-1:0] acc_sum = acc + (prod_x ^ {AW{s2}}) + {{(AW-1){1'b0}}, s2};
   wire d_ge0 = !acc[AW-1];
   // a MAC program starts: after the scan (gate) or after a passed gate with a candidate (rho^2)
-  wire m_start = (state == S_SCAN && j == LAST_J) ||
+  wire m_start = (take && s_last) ||
                  (state == S_MAC && m_done && !m_mode && d_ge0 && min_ok && c_valid);
   wire d_gt0 = d_ge0 && ((acc != 0) || acc_nz);
 
@@ -220,11 +221,8 @@ module peak_detector #(
   wire [TIME_W-1:0] since = n_r - c_n;
   wire emit = c_valid && (c_has_next || hn_now) && since >= HOLD_T;
 
-  // output
-  reg                m_valid_r;
-  reg [CODE_W-1:0]   o_code;
+  // output: held in S_OUT (the registers it is computed from do not change there)
   reg [ARR_W-1:0]    o_arrival;
-  reg [SCORE_W-1:0]  o_score, o_margin;
   localparam integer DECIM_I = DECIM;
   localparam signed [ARR_W-1:0] DECIM_A = {{(ARR_W-32){1'b0}}, DECIM_I[31:0]};
   wire signed [FR_W-1:0] frac = ev_neg ? -$signed(fmag) : $signed(fmag);
@@ -251,86 +249,31 @@ module peak_detector #(
     prod <= ma * mb;
   end
 
+  // ---------------------------------------------------------------- control (reset)
   always @(posedge clk) begin
     if (rst) begin
       state <= S_IDLE;
+      j <= {JB{1'b0}};
       par <= 1'b0; prev_ok <= 1'b0;
       c_valid <= 1'b0; c_has_next <= 1'b0;
       m_run <= 1'b0; m_done <= 1'b0;
       v1 <= 1'b0; v2 <= 1'b0; fin1 <= 1'b0; fin2 <= 1'b0;
-      m_valid_r <= 1'b0;
     end else begin
-      if (m_valid_r && m_ready) m_valid_r <= 1'b0;
-      // MAC pipeline control and accumulator
-      v2 <= v1; s2 <= s1; e2 <= e1; fin2 <= fin1;
-      v1 <= 1'b0; fin1 <= 1'b0;
-      // one write site per register: clear = synchronous reset, else one 2:1 choice
-      if (m_start) begin
-        acc <= {AW{1'b0}};
-        acc_nz <= 1'b0;
-      end else if (v2) begin
-        acc <= e2 ? acc_sum >>> 16 : acc_sum;
-        acc_nz <= acc_nz | (e2 && acc_sum[15:0] != 16'd0);
+      v2 <= v1; fin2 <= fin1; m_done <= fin2;
+      v1 <= m_run;
+      fin1 <= 1'b0;
+      if (m_run && mp && mi == i_hi && mk == KLAST) begin
+        m_run <= 1'b0;
+        fin1 <= 1'b1;
       end
-      m_done <= fin2;
-      if (m_run) begin
-        v1 <= 1'b1; s1 <= mp; e1 <= mp && (mi == i_hi);
-        mp <= ~mp;
-        if (mp) begin
-          if (mi == i_hi) begin
-            mk <= mk1;
-            mi <= i_lo1;
-            if (mk == KLAST) begin
-              m_run <= 1'b0;
-              fin1 <= 1'b1;
-            end
-          end else begin
-            mi <= mi + 1'b1;
-          end
-        end
-      end
+      if (m_start) m_run <= 1'b1;
       case (state)
+        // beats j = 0 .. CODES-1 (own counter, restarted by s_last)
         S_IDLE: if (s_valid) begin
-          q_r <= s_weighted;
-          nrm <= s_energy[ENERGY_W-1 -: NW];
-          n_r <= s_index;
-          best <= 0;
-          best_q <= 0;
-          second <= 0;
-          j <= 0;
-          state <= S_SCAN;
+          j <= s_last ? {JB{1'b0}} : j + 1'b1;
+          if (s_last) state <= S_MAC;
         end
-        S_SCAN: begin
-          // strict > with the running best starting at 0: lowest index on ties
-          if (head > best_q) begin
-            second <= best_q;
-            best_q <= head;
-            best <= j;
-          end else if (head > second) begin
-            second <= head;
-          end
-          if (hn_now && j == c_code) c_qn <= head;
-          q_r <= q_r >> QW;
-          j <= j + 1'b1;
-          if (j == LAST_J) begin
-            state <= S_MAC;
-            m_run <= 1'b1; m_mode <= 1'b0;
-            mk <= 0; mi <= 0; mp <= 1'b0;
-          end
-        end
-        S_MAC: if (m_done) begin
-          if (!m_mode) begin
-            gate_r <= d_ge0 && min_ok;
-            if (d_ge0 && min_ok && c_valid) begin
-              m_run <= 1'b1; m_mode <= 1'b1;
-              mk <= 0; mi <= 0; mp <= 1'b0;
-            end else begin
-              state <= S_DECIDE;
-            end
-          end else begin
-            state <= S_DECIDE;
-          end
-        end
+        S_MAC: if (m_done && !m_start) state <= S_DECIDE;
         S_DECIDE: begin
           par <= ~par;
           prev_ok <= 1'b1;
@@ -339,12 +282,6 @@ module peak_detector #(
           if (gate_r && (!c_valid || d_gt0)) begin
             c_valid <= 1'b1;
             c_has_next <= 1'b0;
-            c_n <= n_r;
-            c_code <= best;
-            c_qp <= prev_ok ? p_rd : {QW{1'b0}};
-            c_q <= best_q;
-            c_q2 <= second;
-            c_norm1 <= norm1;
           end else if (emit) begin
             c_valid <= 1'b0;
             c_has_next <= 1'b0;
@@ -353,66 +290,112 @@ module peak_detector #(
             c_has_next <= c_valid;
           end
         end
-        // dQ into dv_r, Q_prev + Q_next into dv_d
-        S_P0: begin
-          dv_r <= {{(W-QW){1'b0}}, c_qn} - {{(W-QW){1'b0}}, c_qp};
-          dv_d <= {{(W-QW){1'b0}}, c_qn} + {{(W-QW){1'b0}}, c_qp};
-          state <= S_P1;
-        end
-        // |dQ| (restoring remainder), den = 4Q - 2(Q_prev + Q_next)
-        S_P1: begin
-          ev_neg <= dv_r[W-1];
-          dv_r <= dv_r[W-1] ? -dv_r : dv_r;
-          dv_d <= ({{(W-QW){1'b0}}, c_q} << 2) - (dv_d << 1);
-          dv_q <= 0;
-          dv_cnt <= 0;
-          dsel <= 2'd0;
-          fmag <= 0;
-          state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
-        end
-        S_DIV: begin
-          dv_r <= dv_ge ? dv_sub[W-1:0] : dv_sh[W-1:0];
-          dv_q <= {dv_q[KM-2:0], dv_ge};
-          dv_cnt <= dv_cnt + 1'b1;
-          if (dv_cnt + 1'b1 == dv_k) state <= S_NEXT;
-        end
-        S_NEXT: begin
-          dv_cnt <= 0;
-          dv_d <= {{(W-NW){1'b0}}, c_norm1};
-          state <= S_DIV;
-          if (dsel == 2'd0) begin
-            if (FRAC_W > 0 && den_pos)
-              fmag <= dv_q[KF1] ? HALF : fq;
-            dsel <= 2'd1;
-            dv_r <= {{(W-QW-1){1'b0}}, q_hi};
-            dv_q <= q_lo;
-          end else if (dsel == 2'd1) begin
-            sc1 <= score_now;
-            dsel <= 2'd2;
-            dv_r <= {{(W-QW-1){1'b0}}, q2_hi};
-            dv_q <= q2_lo;
-          end else begin
-            state <= S_OUT;
-          end
-        end
-        S_OUT: if (!m_valid_r) begin
-          m_valid_r <= 1'b1;
-          o_code <= code_x[CODE_W-1:0] + 1'b1;
-          o_arrival <= arrival;
-          o_score <= sc1;
-          o_margin <= sc1 - score_now;
-          state <= S_IDLE;
-        end
+        S_P0: state <= S_P1;
+        S_P1: state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
+        S_DIV: if (dv_cnt + 1'b1 == dv_k) state <= S_NEXT;
+        S_NEXT: state <= (dsel == 2'd2) ? S_OUT : S_DIV;
+        S_OUT: if (m_ready) state <= S_IDLE;
         default: state <= S_IDLE;
       endcase
     end
   end
 
-  assign m_valid   = m_valid_r;
-  assign m_code    = o_code;
+  // ---------------------------------------------------------------- datapath (no reset)
+  always @(posedge clk) begin
+    // MAC program counters and accumulator (one write site per register)
+    s2 <= s1; e2 <= e1;
+    s1 <= mp; e1 <= mp && (mi == i_hi);
+    if (m_start) begin
+      mk <= {KW{1'b0}}; mi <= {IW{1'b0}}; mp <= 1'b0;
+      m_mode <= (state == S_MAC);
+    end else if (m_run) begin
+      mp <= ~mp;
+      if (mp) begin
+        if (mi == i_hi) begin
+          mk <= mk1;
+          mi <= i_lo1;
+        end else begin
+          mi <= mi + 1'b1;
+        end
+      end
+    end
+    if (m_start) begin
+      acc <= {AW{1'b0}};
+      acc_nz <= 1'b0;
+    end else if (v2) begin
+      acc <= e2 ? acc_sum >>> 16 : acc_sum;
+      acc_nz <= acc_nz | (e2 && acc_sum[15:0] != 16'd0);
+    end
+    // scan, one beat per clock: strict > from the first beat on, lowest index on ties
+    if (take) begin
+      if (gt_best || first) begin
+        best_q <= head;
+        best <= j;
+      end
+      if (first) second <= {QW{1'b0}};
+      else if (gt_best) second <= best_q;
+      else if (gt_second) second <= head;
+      if (hn_now && j == c_code) c_qn <= head;
+      nrm <= s_energy[ENERGY_W-1 -: NW];
+      n_r <= s_index;
+    end
+    if (state == S_MAC && m_done && !m_mode) gate_r <= d_ge0 && min_ok;
+    if (state == S_DECIDE && gate_r && (!c_valid || d_gt0)) begin
+      c_n <= n_r;
+      c_code <= best;
+      c_qp <= prev_ok ? p_rd : {QW{1'b0}};
+      c_q <= best_q;
+      c_q2 <= second;
+      c_norm1 <= norm1;
+    end
+    case (state)
+      // dQ into dv_r, Q_prev + Q_next into dv_d
+      S_P0: begin
+        dv_r <= {{(W-QW){1'b0}}, c_qn} - {{(W-QW){1'b0}}, c_qp};
+        dv_d <= {{(W-QW){1'b0}}, c_qn} + {{(W-QW){1'b0}}, c_qp};
+      end
+      // |dQ| (restoring remainder), den = 4Q - 2(Q_prev + Q_next)
+      S_P1: begin
+        ev_neg <= dv_r[W-1];
+        dv_r <= dv_r[W-1] ? -dv_r : dv_r;
+        dv_d <= ({{(W-QW){1'b0}}, c_q} << 2) - (dv_d << 1);
+        dv_q <= {KM{1'b0}};
+        dv_cnt <= {CW{1'b0}};
+        dsel <= 2'd0;
+        fmag <= {FR_W{1'b0}};
+      end
+      S_DIV: begin
+        dv_r <= dv_ge ? dv_sub[W-1:0] : dv_sh[W-1:0];
+        dv_q <= {dv_q[KM-2:0], dv_ge};
+        dv_cnt <= dv_cnt + 1'b1;
+      end
+      S_NEXT: begin
+        dv_cnt <= {CW{1'b0}};
+        dv_d <= {{(W-NW){1'b0}}, c_norm1};
+        if (dsel == 2'd0) begin
+          if (FRAC_W > 0 && den_pos)
+            fmag <= dv_q[KF1] ? HALF : fq;
+          dsel <= 2'd1;
+          dv_r <= {{(W-QW-1){1'b0}}, q_hi};
+          dv_q <= q_lo;
+        end else if (dsel == 2'd1) begin
+          sc1 <= score_now;
+          dsel <= 2'd2;
+          dv_r <= {{(W-QW-1){1'b0}}, q2_hi};
+          dv_q <= q2_lo;
+        end else begin
+          o_arrival <= arrival;
+        end
+      end
+      default: ;
+    endcase
+  end
+
+  assign m_valid   = (state == S_OUT);
+  assign m_code    = code_x[CODE_W-1:0] + 1'b1;
   assign m_arrival = o_arrival;
-  assign m_score   = o_score;
-  assign m_margin  = o_margin;
+  assign m_score   = sc1;
+  assign m_margin  = sc1 - score_now;
 endmodule
 
 `default_nettype wire

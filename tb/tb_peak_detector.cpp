@@ -46,24 +46,24 @@ const ReceiverDesign& design() {
   return d;
 }
 
-template <std::size_t N>
-void set_bits(VlWide<N>& w, int lo, int width, std::uint64_t v) {
-  for (int b = 0; b < width; ++b) {
-    const int i = lo + b;
-    const std::uint32_t m = 1u << (i % 32);
-    auto& word = w[static_cast<std::size_t>(i / 32)];
-    word = ((v >> b) & 1u) ? (word | m) : (word & ~m);
-  }
-}
 std::int64_t sext(std::uint64_t v, int width) {
   const std::uint64_t m = std::uint64_t{1} << (width - 1);
   return static_cast<std::int64_t>(((v & ((m << 1) - 1)) ^ m) - m);
 }
 
+// One bank output (a group): Q_j of every code, E, n. The detector receives it as CODES beats.
 struct Beat {
   std::vector<std::uint64_t> q;
   std::uint64_t energy = 0, index = 0;
 };
+
+// Drive beat j of group g on the slave port (data only; s_valid is the caller's).
+void drive_beat(Vpeak_detector& t, const Beat& g, std::size_t j) {
+  t.s_weighted = g.q[j];
+  t.s_last = j + 1 == g.q.size() ? 1 : 0;
+  t.s_energy = g.energy;
+  t.s_index = g.index;
+}
 
 // Filtered received bursts, one after the other (a new burst every `spacing` samples).
 std::vector<std::int64_t> burst_stream(std::uint64_t seed, double noise, std::size_t bursts) {
@@ -161,14 +161,14 @@ class DetSim {
 };
 
 struct Totals {
-  std::uint64_t inputs = 0, beats = 0, events = 0, mismatches = 0;
+  std::uint64_t inputs = 0, groups = 0, beats = 0, events = 0, mismatches = 0;
   std::string first;
 };
 
 void run_stream(DetSim& sim, const std::vector<std::int64_t>& y, double gap, double stall,
                 std::mt19937_64& rng, const std::string& what, Totals& tot) {
   const auto& d = design();
-  const int ww = d.layout.weighted_bits, fb = d.config.detector.frac_bits;
+  const int fb = d.config.detector.frac_bits;
   std::vector<Beat> beats;
   std::vector<EventFixed> events;
   std::size_t before = 0;
@@ -177,7 +177,7 @@ void run_stream(DetSim& sim, const std::vector<std::int64_t>& y, double gap, dou
   model(y, split, beats, events, before);
   tot.inputs += y.size();
   sim.reset();
-  std::size_t in = 0, got = 0;
+  std::size_t in = 0, jb = 0, got = 0;  // group, beat within the group
   bool presenting = false, did_reset = false;
   std::uint64_t cycles = 0;
   auto fail = [&](const std::string& msg) {
@@ -188,7 +188,7 @@ void run_stream(DetSim& sim, const std::vector<std::int64_t>& y, double gap, dou
   EventFixed held;
   while (in < beats.size() || got < events.size() || holding) {
     auto& t = sim.top();
-    if (!did_reset && in == split) {
+    if (!did_reset && in == split && jb == 0) {
       // Drain what the first half produced, then reset in the middle of the stream.
       if (got == before && t.s_ready && !t.m_valid) {
         sim.reset();
@@ -200,13 +200,7 @@ void run_stream(DetSim& sim, const std::vector<std::int64_t>& y, double gap, dou
       presenting = u(rng) >= gap;
     }
     t.s_valid = presenting ? 1 : 0;
-    if (in < beats.size()) {
-      for (std::size_t j = 0; j < beats[in].q.size(); ++j) {
-        set_bits(t.s_weighted, static_cast<int>(j) * ww, ww, beats[in].q[j]);
-      }
-      t.s_energy = beats[in].energy;
-      t.s_index = beats[in].index;
-    }
+    if (in < beats.size()) drive_beat(t, beats[in], jb);
     t.m_ready = u(rng) >= stall ? 1 : 0;
     t.eval();
     if (t.m_valid) {
@@ -234,12 +228,16 @@ void run_stream(DetSim& sim, const std::vector<std::int64_t>& y, double gap, dou
       }
     }
     if (t.s_valid && t.s_ready) {
-      ++in;
       ++tot.beats;
+      if (++jb == beats[in].q.size()) {
+        jb = 0;
+        ++in;
+        ++tot.groups;
+      }
       presenting = false;
     }
     sim.tick();
-    if (++cycles > 400 * (beats.size() + 10)) {
+    if (++cycles > 600 * (beats.size() + 10)) {
       fail("timeout: " + std::to_string(got) + " of " + std::to_string(events.size()) + " events");
       break;
     }
@@ -263,8 +261,10 @@ TEST(PeakDetectorRtl, EventsBitExactUnderGapsBackPressureAndReset) {
     const auto y = burst_stream(100 + static_cast<std::uint64_t>(s), s == 1 ? 0.01 : 0.002, 27);
     run_stream(sim, y, gaps[s], stalls[s], rng, "stream " + std::to_string(s), tot);
   }
-  std::printf("peak_detector: %llu input samples (model bank), %llu beats, %llu events compared, %llu mismatches\n",
-              static_cast<unsigned long long>(tot.inputs), static_cast<unsigned long long>(tot.beats),
+  std::printf("peak_detector: %llu input samples (model bank), %llu groups, %llu beats, %llu events compared, "
+              "%llu mismatches\n",
+              static_cast<unsigned long long>(tot.inputs), static_cast<unsigned long long>(tot.groups),
+              static_cast<unsigned long long>(tot.beats),
               static_cast<unsigned long long>(tot.events), static_cast<unsigned long long>(tot.mismatches));
   EXPECT_EQ(tot.mismatches, 0u) << tot.first;
   EXPECT_GT(tot.events, 50u);
@@ -343,36 +343,32 @@ class RefDetector {
 };
 
 struct PacedResult {
-  std::uint64_t stalls = 0, mismatches = 0, events = 0, max_busy = 0, max_busy_event = 0;
+  std::uint64_t stalls = 0, late = 0, mismatches = 0, events = 0, max_busy = 0, max_busy_event = 0;
   std::string first;
 };
 
-// One beat every `period` clocks (or back to back when 0), m_ready = 1. A stall is a presented
-// beat that is not accepted on its first clock. Busy: clocks from a beat's acceptance until
-// s_ready is high again.
+// One group every `period` clocks (or back to back when 0), its CODES beats on consecutive
+// clocks, m_ready = 1. A stall is a presented beat that is not accepted on its first clock; a
+// group is late when its last beat is accepted when the next group is already due. Busy: clocks
+// from a group's first beat to s_ready high again after its last beat (the group's whole time).
 PacedResult run_paced(DetSim& sim, const std::vector<Beat>& beats, const std::vector<EventFixed>& expected,
                       std::uint64_t period) {
   const auto& d = design();
-  const int ww = d.layout.weighted_bits, fb = d.config.detector.frac_bits;
+  const int fb = d.config.detector.frac_bits;
   PacedResult r;
   auto fail = [&](const std::string& m) {
     ++r.mismatches;
     if (r.first.empty()) r.first = m;
   };
   sim.reset();
-  std::size_t in = 0, got = 0;
-  std::uint64_t cycle = 0, due = 0, accepted_at = 0, busy_start_events = 0;
+  std::size_t in = 0, jb = 0, got = 0;
+  std::uint64_t cycle = 0, due = 0, started_at = 0, busy_start_events = 0;
   bool busy = false, first_clock = true;
   while ((in < beats.size() || busy) && cycle < (beats.size() + 10) * (period + 400)) {
     auto& t = sim.top();
     const bool present = in < beats.size() && cycle >= due;
     t.s_valid = present ? 1 : 0;
-    if (present) {
-      for (std::size_t j = 0; j < beats[in].q.size(); ++j)
-        set_bits(t.s_weighted, static_cast<int>(j) * ww, ww, beats[in].q[j]);
-      t.s_energy = beats[in].energy;
-      t.s_index = beats[in].index;
-    }
+    if (present) drive_beat(t, beats[in], jb);
     t.m_ready = 1;
     t.eval();
     if (t.m_valid) {
@@ -393,8 +389,8 @@ PacedResult run_paced(DetSim& sim, const std::vector<Beat>& beats, const std::ve
       }
       ++got;
     }
-    if (busy && t.s_ready) {  // the event (if any) leaves on the clock s_ready rises
-      const std::uint64_t b = cycle - accepted_at;
+    if (busy && t.s_ready && jb == 0) {  // the event (if any) leaves on the clock s_ready rises
+      const std::uint64_t b = cycle - started_at;
       r.max_busy = std::max(r.max_busy, b);
       if (got > busy_start_events) r.max_busy_event = std::max(r.max_busy_event, b);
       busy = false;
@@ -403,23 +399,29 @@ PacedResult run_paced(DetSim& sim, const std::vector<Beat>& beats, const std::ve
       if (first_clock && !t.s_ready) ++r.stalls;
       first_clock = false;
       if (t.s_ready) {
-        ++in;
-        busy = true;
-        accepted_at = cycle;
-        busy_start_events = got;
-        due = period ? due + period : cycle + 1;
         first_clock = true;
+        if (jb == 0) {
+          started_at = cycle;
+          busy_start_events = got;
+        }
+        if (++jb == beats[in].q.size()) {
+          jb = 0;
+          ++in;
+          busy = true;
+          if (period && cycle >= due + period) ++r.late;
+          due = period ? due + period : cycle + 1;
+        }
       }
     }
     sim.tick();
     ++cycle;
   }
-  for (int i = 0; i < 400; ++i) {  // drain: the last beat's event, nothing else
+  for (int i = 0; i < 400; ++i) {  // drain: the last group's event, nothing else
     sim.top().s_valid = 0;
     sim.top().m_ready = 1;
     sim.top().eval();
     if (sim.top().m_valid) {
-      if (got >= expected.size()) fail("extra event after the last beat");
+      if (got >= expected.size()) fail("extra event after the last group");
       ++got;
     }
     sim.tick();
@@ -445,13 +447,15 @@ TEST(PeakDetectorRtl, PacedAtTheBankRateNeverStallsAndStaysBitExact) {
   EXPECT_EQ(ref_events, events);
   DetSim sim;
   const auto r = run_paced(sim, beats, events, period);
-  std::printf("peak_detector paced: %zu beats, one every %llu clocks, %llu events, %llu stalls; "
-              "max clocks busy per beat %llu, per beat with an event %llu\n",
-              beats.size(), static_cast<unsigned long long>(period), static_cast<unsigned long long>(r.events),
-              static_cast<unsigned long long>(r.stalls), static_cast<unsigned long long>(r.max_busy),
+  std::printf("peak_detector paced: %zu groups of %zu beats, one group every %llu clocks, %llu events, "
+              "%llu stalled beats, %llu late groups; max clocks per group %llu, per group with an event %llu\n",
+              beats.size(), beats.front().q.size(), static_cast<unsigned long long>(period),
+              static_cast<unsigned long long>(r.events), static_cast<unsigned long long>(r.stalls),
+              static_cast<unsigned long long>(r.late), static_cast<unsigned long long>(r.max_busy),
               static_cast<unsigned long long>(r.max_busy_event));
   EXPECT_EQ(r.mismatches, 0u) << r.first;
   EXPECT_EQ(r.stalls, 0u);
+  EXPECT_EQ(r.late, 0u);
   EXPECT_GT(r.events, 30u);
   EXPECT_GT(r.max_busy_event, 0u);
   EXPECT_LE(r.max_busy_event, period);
@@ -551,10 +555,10 @@ TEST(PeakDetectorRtl, DividerAndCrossProductEdgeCases) {
   }
   DetSim sim;
   const auto r = run_paced(sim, beats, expected, 0);
-  std::printf("peak_detector edge cases, back to back: max clocks busy per beat %llu, per beat with an event %llu\n",
+  std::printf("peak_detector edge cases, back to back: max clocks per group %llu, per group with an event %llu\n",
               static_cast<unsigned long long>(r.max_busy), static_cast<unsigned long long>(r.max_busy_event));
   EXPECT_LE(r.max_busy_event, static_cast<std::uint64_t>(d.layout.decimation) * 6);
-  std::printf("peak_detector edge cases: %zu beats, %zu events (score: %d at the cap, %d at cap - 1; fraction: "
+  std::printf("peak_detector edge cases: %zu groups, %zu events (score: %d at the cap, %d at cap - 1; fraction: "
               "%d at +1/2, %d at -1/2, %d at +-(1/2 - 1 lsb), %d with denominator <= 0), %llu mismatches\n",
               beats.size(), expected.size(), at_cap, below_cap, plus_half, minus_half, inner, den_le0,
               static_cast<unsigned long long>(r.mismatches));
