@@ -23,8 +23,11 @@
 //            (113 us at 1.5 Mbaud), shorter than a burst period, so one frame
 //            per measurement never backs up.
 //
-// Stream:    s_valid/s_ready: one measurement per frame; s_ready is high only
-//            between frames (the measurement is latched at the handshake).
+// Stream:    s_valid/s_ready: one measurement per frame. Nothing is latched: the
+//            bytes are selected from the s_* inputs, which AXI4-Stream keeps stable
+//            while s_valid && !s_ready, and s_ready completes the handshake when
+//            the frame's last byte is handed to the transmitter (a 17:1 byte
+//            multiplexer instead of a 136-bit frame register).
 //
 ////////////////////////////////////////////////////////////////////////////////
 `default_nettype none
@@ -46,8 +49,8 @@ module measurement_uart #(
   output wire tx
 );
   localparam integer BYTES = 17;
-  reg [8*BYTES-1:0] frame;
-  reg [4:0] left;  // bytes left, 0 = idle
+  reg       busy;
+  reg [4:0] idx;  // byte being sent, 0..BYTES-1
   wire byte_ready;
 
   wire [8*14-1:0] payload = {s_margin, s_score, s_distance, s_tof, s_flags, s_code};
@@ -57,27 +60,28 @@ module measurement_uart #(
     x = 8'h00;
     for (i = 0; i < 14; i = i + 1) x = x ^ payload[8*i +: 8];
   end
+  wire [8*BYTES-1:0] frame = {x, payload, 8'h5A, 8'hA5};
+  wire [7:0] byte_now = frame[8*idx +: 8];
+  wire last_byte = idx == BYTES - 1;
 
-  assign s_ready = left == 0;
+  assign s_ready = busy && last_byte && byte_ready;
 
   always @(posedge clk) begin
     if (rst) begin
-      left <= 0;
-      frame <= 0;
-    end else if (left == 0) begin
-      if (s_valid) begin
-        frame <= {x, payload, 8'h5A, 8'hA5};
-        left <= BYTES[4:0];
-      end
+      busy <= 1'b0;
+      idx <= 0;
+    end else if (!busy) begin
+      busy <= s_valid;
+      idx <= 0;
     end else if (byte_ready) begin
-      frame <= {8'h00, frame[8*BYTES-1:8]};
-      left <= left - 1'b1;
+      if (last_byte) busy <= 1'b0;
+      idx <= idx + 1'b1;
     end
   end
 
   uart_tx #(.BAUD_DIV(BAUD_DIV)) u_tx (
     .clk(clk), .rst(rst),
-    .s_data(frame[7:0]), .s_valid(left != 0), .s_ready(byte_ready),
+    .s_data(byte_now), .s_valid(busy), .s_ready(byte_ready),
     .tx(tx)
   );
 endmodule
