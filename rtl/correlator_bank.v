@@ -100,6 +100,7 @@ module correlator_bank #(
   parameter integer WINDOW = 1005,
   parameter integer ENERGY_W = 41,
   parameter integer TIME_W = 40,
+  parameter integer CODE_W = 4,
   parameter [PERIOD*LO_W-1:0]     LO_COS = 0,
   parameter [PERIOD*LO_W-1:0]     LO_SIN = 0,
   parameter [TAPS*TAP_W-1:0]      TAP_VALUES = 0,
@@ -110,11 +111,13 @@ module correlator_bank #(
   input  wire clk, rst,
   input  wire signed [DATA_W-1:0] s_data, input wire s_valid, output wire s_ready,
   output wire m_valid, input wire m_ready,
-  output wire [CODES*WEIGHTED_W-1:0] m_weighted,
+  output wire [WEIGHTED_W-1:0]       m_weighted,
+  output wire [CODE_W-1:0]           m_code,
+  output wire                        m_last,
   output wire [ENERGY_W-1:0]         m_energy,
   output wire [TIME_W-1:0]           m_index,
   output wire signed [CHIP_W-1:0]    m_chip_re, m_chip_im,
-  output wire [CODES*CORR_W-1:0]     m_corr_re, m_corr_im
+  output wire signed [CORR_W-1:0]    m_corr_re, m_corr_im
 );
   // ---------------------------------------------------------------- helpers
   function integer imax;
@@ -367,15 +370,15 @@ module correlator_bank #(
   reg [BA_W-1:0]          bd_wptr;
   reg [TI_W-1:0]          bd_cnt;
   reg                     bd_pend;
-  reg [ENERGY_W-1:0]      eq0, eq1;
-  reg [1:0]               eq_n;
-  wire                    e_pop;   // back end takes eq0 (output start)
+  reg [ENERGY_W-1:0]      eq0, eq1, eq2;  // 3-entry ring of group energies
+  reg [1:0]               eq_n, eq_w, eq_r;
+  wire                    e_pop;   // the consumer took the last beat of eq0's group
   wire                    a_start; // FIR takes the pending Bd
 
   // B history (PERIOD x {re, im}) and y history (WINDOW x y): synchronous-read memories.
-  reg [2*MIX_W-1:0] b_mem [0:PERIOD-1];
+  (* no_rw_check *) reg [2*MIX_W-1:0] b_mem [0:PERIOD-1];
   reg [2*MIX_W-1:0] b_rd;
-  reg [DATA_W-1:0]  y_mem [0:WINDOW-1];
+  (* no_rw_check *) reg [DATA_W-1:0]  y_mem [0:WINDOW-1];
   reg [DATA_W-1:0]  y_rd;
   wire fe_write = (fe_state == FE_M4);
   always @(posedge clk) begin
@@ -387,11 +390,11 @@ module correlator_bank #(
     y_rd <= y_mem[y_ptr];
   end
   // Bd history: written by the front end at a hand-off, read by the FIR.
-  reg [2*DEC_W-1:0] bd_mem [0:BDN-1];
+  (* no_rw_check *) reg [2*DEC_W-1:0] bd_mem [0:BDN-1];
   reg [2*DEC_W-1:0] bd_rd;
   reg [BA_W-1:0]    a_addr_nx;
   wire [BA_W-1:0] bd_wptr_next = (bd_wptr == BD_LAST) ? {BA_W{1'b0}} : bd_wptr + 1'b1;
-  wire hand_ok = !bd_pend && (eq_n != 2'd2);
+  wire hand_ok = !bd_pend && (eq_n != 2'd3);
   wire hand = hand_ok && (fe_state == FE_HAND);
   always @(posedge clk) begin
     if (hand) bd_mem[bd_wptr_next] <= {acc_re, acc_im};
@@ -425,21 +428,22 @@ module correlator_bank #(
       y_ptr <= Y_LAST;  // the model pre-increments the window index
       dphase <= 0;
       bd_wptr <= BD_LAST; bd_cnt <= 0; bd_pend <= 1'b0;
-      eq0 <= 0; eq1 <= 0; eq_n <= 2'd0;
+      eq0 <= 0; eq1 <= 0; eq2 <= 0; eq_n <= 2'd0; eq_w <= 2'd0; eq_r <= 2'd0;
     end else begin
       if (a_start) bd_pend <= 1'b0;
-      // energy queue: pop at an output start, push at a hand-off (both may happen at once)
-      if (e_pop) begin
-        eq0 <= eq1;
-        if (hand) begin
-          if (eq_n == 2'd1) eq0 <= energy_new; else eq1 <= energy_new;
-        end else begin
-          eq_n <= eq_n - 1'b1;
-        end
-      end else if (hand) begin
-        if (eq_n == 2'd0) eq0 <= energy_new; else eq1 <= energy_new;
-        eq_n <= eq_n + 1'b1;
+      // energy ring (E of the groups handed off and not yet read): push at a hand-off, pop
+      // when the consumer takes a group's last beat (both may happen at once)
+      if (hand) begin
+        case (eq_w)
+          2'd0: eq0 <= energy_new;
+          2'd1: eq1 <= energy_new;
+          default: eq2 <= energy_new;
+        endcase
+        eq_w <= (eq_w == 2'd2) ? 2'd0 : eq_w + 1'b1;
       end
+      if (e_pop) eq_r <= (eq_r == 2'd2) ? 2'd0 : eq_r + 1'b1;
+      if (hand && !e_pop) eq_n <= eq_n + 1'b1;
+      else if (e_pop && !hand) eq_n <= eq_n - 1'b1;
       if (hand) begin
         bd_wptr <= bd_wptr_next;
         if (bd_cnt != TAPS_N) bd_cnt <= bd_cnt + 1'b1;
@@ -553,7 +557,7 @@ module correlator_bank #(
   reg [FA_W-1:0]   f_wptr, f_rptr, f_old;
   reg [DIST_W-1:0] f_cnt, f_dist;
   reg [CA_W-1:0]   ca_re, ca_im;
-  reg [2*CHIP_W-1:0] f_mem [0:FN-1];
+  (* no_rw_check *) reg [2*CHIP_W-1:0] f_mem [0:FN-1];
   reg [2*CHIP_W-1:0] f_rd;
   wire [FA_W-1:0] f_wptr_next = (f_wptr == F_LAST) ? {FA_W{1'b0}} : f_wptr + 1'b1;
   wire [FA_W-1:0] f_oldest    = (f_wptr_next == F_LAST) ? {FA_W{1'b0}} : f_wptr_next + 1'b1;
@@ -613,18 +617,33 @@ module correlator_bank #(
   // F_re is written 2 clocks after the last re product issues: only when fres is free.
   wire a_iss  = !w_iss && !sq_iss && a_busy && !(!a_lane && a_last && fres_valid);
 
-  // ---- output
-  reg       b_busy, m_valid_r;
-  reg [ENERGY_W-1:0]      out_energy;
+  // ---- output: ping-pong group buffer (2 banks x 2^JI_W codes) of Q_j and {Cq_re, Cq_im}_j
+  // in synchronous-read memories; the back end writes bank wr_bank, the consumer reads beat
+  // rd_j of bank rd_bank; g_full counts banks holding a finished group not yet fully read.
+  localparam integer GA_W = JI_W + 1;
+  reg                     b_busy, wr_bank, rd_bank;
+  reg [1:0]               g_full;
+  reg [JI_W-1:0]          rd_j;
   reg [TIME_W-1:0]        out_index;
-  reg signed [CHIP_W-1:0] out_chip_re, out_chip_im;
-  reg [CODES*CORR_W-1:0]  out_corr_re, out_corr_im;
-  reg [CODES*WEIGHTED_W-1:0] out_weighted;
+  reg signed [CHIP_W-1:0] chip_re0, chip_im0, chip_re1, chip_im1;  // F per bank (debug)
+  (* no_rw_check *) reg [WEIGHTED_W-1:0]    q_mem [0:(1 << GA_W)-1];
+  (* no_rw_check *) reg [2*CORR_W-1:0]      c_mem [0:(1 << GA_W)-1];
+  reg [WEIGHTED_W-1:0]    q_rd;
+  reg [2*CORR_W-1:0]      c_rd;
   wire b_tags = (s1_v && s1_cl != CL_A) || (s2_v && s2_cl != CL_A);
   wire b_done = b_busy && (c_state == C_IDLE) && !cq_valid && !pw_valid && !b_tags;
-  assign b_start = !b_busy && fres_valid && !m_valid_r;
-  assign e_pop = b_start;
+  assign b_start = !b_busy && fres_valid && (g_full != 2'd2);
+  wire m_last_w = (rd_j == J_LAST);
+  wire m_take   = (g_full != 2'd0) && m_ready;
+  wire g_taken  = m_take && m_last_w;
+  assign e_pop = g_taken;
   assign a_start = !a_busy && bd_pend;
+  // Read address look-ahead: the beat presented next clock, so q_rd/c_rd are the current
+  // beat's words and stay put while it is not taken.
+  wire [JI_W-1:0] rd_j_nx    = !m_take ? rd_j : (m_last_w ? {JI_W{1'b0}} : rd_j + 1'b1);
+  wire            rd_bank_nx = rd_bank ^ g_taken;
+  wire q_we = s2_v && (s2_cl == CL_W) && s2_last;
+  wire c_we = (c_state == C_Q) && !cq_valid;
 
   // FIR read address: the Bd entry of the op presented next clock.
   always @(*) begin
@@ -633,8 +652,13 @@ module correlator_bank #(
     else a_addr_nx = a_addr;
   end
 
-  integer jw;
   wire [WEIGHTED_W-1:0] q_sum = (s2_first ? {WEIGHTED_W{1'b0}} : q_acc) + psh[WEIGHTED_W-1:0];
+  always @(posedge clk) begin
+    if (q_we) q_mem[{wr_bank, s2_j}] <= q_sum;
+    if (c_we) c_mem[{wr_bank, c_j}] <= {cq_re_n, cq_im_n};
+    q_rd <= q_mem[{rd_bank_nx, rd_j_nx}];
+    c_rd <= c_mem[{rd_bank_nx, rd_j_nx}];
+  end
   wire [FIR_W-1:0] facc_base = s2_first ? {FIR_W{1'b0}} : facc;
   // +-|product| as one adder: base + (p ^ -neg) + neg, the carry-in entering as a low bit
   /* verilator lint_off UNUSEDSIGNAL */
@@ -656,12 +680,15 @@ module correlator_bank #(
       cq_re <= 0; cq_im <= 0; cq_valid <= 1'b0;
       cq_j <= 0; sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
       p_acc <= 0; p_w <= 0; pw_valid <= 1'b0; pw_j <= 0; w_la <= 0; w_lb <= 0; q_acc <= 0;
-      b_busy <= 1'b0; m_valid_r <= 1'b0;
-      out_energy <= 0; out_index <= {TIME_W{1'b1}};  // + DECIM = DECIM-1 at the first output
-      out_chip_re <= 0; out_chip_im <= 0;
-      out_corr_re <= 0; out_corr_im <= 0; out_weighted <= 0;
+      b_busy <= 1'b0; wr_bank <= 1'b0; rd_bank <= 1'b0; g_full <= 2'd0; rd_j <= 0;
+      out_index <= DECIM_T - 1'b1;
+      chip_re0 <= 0; chip_im0 <= 0; chip_re1 <= 0; chip_im1 <= 0;
     end else begin
-      if (m_valid_r && m_ready) m_valid_r <= 1'b0;
+      rd_j <= rd_j_nx;
+      rd_bank <= rd_bank_nx;
+      if (g_taken) out_index <= out_index + DECIM_T;
+      if (b_done && !g_taken) g_full <= g_full + 1'b1;
+      else if (g_taken && !b_done) g_full <= g_full - 1'b1;
       a_addr <= a_addr_nx;
 
       // ---------------- issue (one limb product per clock)
@@ -759,12 +786,7 @@ module correlator_bank #(
               pw_j <= s2_j;
             end else p_acc <= p_acc + psh[PW_W-1:0];
           end
-          default: begin
-            // per-slot write enables (a variable part-select would build a 432-bit shifter)
-            for (jw = 0; jw < CODES; jw = jw + 1)
-              if (s2_last && s2_j == jw[JI_W-1:0]) out_weighted[jw*WEIGHTED_W +: WEIGHTED_W] <= q_sum;
-            if (!s2_last) q_acc <= q_sum;
-          end
+          default: if (!s2_last) q_acc <= q_sum;  // the last sum goes to q_mem
         endcase
       end
 
@@ -790,12 +812,7 @@ module correlator_bank #(
           cq_re <= cq_re_n;
           cq_im <= cq_im_n;
           ca_re <= {CA_W{1'b0}};
-          ca_im <= {CA_W{1'b0}};
-          for (jw = 0; jw < CODES; jw = jw + 1)
-            if (c_j == jw[JI_W-1:0]) begin
-              out_corr_re[jw*CORR_W +: CORR_W] <= cq_re_n;
-              out_corr_im[jw*CORR_W +: CORR_W] <= cq_im_n;
-            end
+          ca_im <= {CA_W{1'b0}};  // {cq_re_n, cq_im_n} -> c_mem (c_we)
           cq_valid <= 1'b1;
           cq_j <= c_j;
           sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
@@ -816,10 +833,11 @@ module correlator_bank #(
       if (b_start) begin
         b_busy <= 1'b1;
         fres_valid <= 1'b0;
-        out_chip_re <= fres_re;
-        out_chip_im <= fres_im;
-        out_energy <= eq0;
-        out_index <= out_index + DECIM_T;
+        if (wr_bank) begin
+          chip_re1 <= fres_re; chip_im1 <= fres_im;
+        end else begin
+          chip_re0 <= fres_re; chip_im0 <= fres_im;
+        end
         f_wptr <= f_wptr_next;
         if (f_cnt != FN_N) f_cnt <= f_cnt + 1'b1;
         // oldest combiner tap: k - (CHIPS-1) CHIP_STEP = k + 1 (mod FN)
@@ -832,19 +850,24 @@ module correlator_bank #(
       end
       if (b_done) begin
         b_busy <= 1'b0;
-        m_valid_r <= 1'b1;
+        wr_bank <= !wr_bank;
       end
     end
   end
 
-  assign m_valid    = m_valid_r;
-  assign m_weighted = out_weighted;
-  assign m_energy   = out_energy;
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [CODE_W+JI_W-1:0] code_x = {{CODE_W{1'b0}}, rd_j};
+  /* verilator lint_on UNUSEDSIGNAL */
+  assign m_valid    = (g_full != 2'd0);
+  assign m_weighted = q_rd;
+  assign m_code     = code_x[CODE_W-1:0];
+  assign m_last     = m_last_w;
+  assign m_energy   = (eq_r == 2'd0) ? eq0 : (eq_r == 2'd1) ? eq1 : eq2;
   assign m_index    = out_index;
-  assign m_chip_re  = out_chip_re;
-  assign m_chip_im  = out_chip_im;
-  assign m_corr_re  = out_corr_re;
-  assign m_corr_im  = out_corr_im;
+  assign m_chip_re  = rd_bank ? chip_re1 : chip_re0;
+  assign m_chip_im  = rd_bank ? chip_im1 : chip_im0;
+  assign m_corr_re  = c_rd[2*CORR_W-1:CORR_W];
+  assign m_corr_im  = c_rd[CORR_W-1:0];
 endmodule
 
 `default_nettype wire

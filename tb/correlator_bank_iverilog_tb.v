@@ -1,8 +1,11 @@
 // Icarus testbench of rtl/correlator_bank.v: feeds $readmemh input samples (+vin=FILE) and
-// compares every decimated output with the model's ($readmemh +vout=FILE, one word per output:
-// {corr_im, corr_re, chip_im, chip_re, index, energy, weighted}), with a periodic m_ready
-// stall; checks that no output is X after reset. Instantiated by a wrapper generated from the
-// .vc parameters (tb/tb_correlator_bank.cpp). Prints "RESULT outputs=N mismatches=M xs=X".
+// compares every beat of every decimated output with the model's ($readmemh +vout=FILE, one
+// word per beat: {corr_im, corr_re, chip_im, chip_re, index, energy, last, code, weighted}),
+// with a periodic m_ready stall; checks that s_ready and m_valid are never X after reset and
+// that no m_* field is X on a valid beat (the beat words come from a synchronous-read memory
+// that is not reset, so they are undefined while m_valid is low, as AXI-Stream allows).
+// Instantiated by a wrapper generated from the .vc parameters (tb/tb_correlator_bank.cpp).
+// Prints "RESULT outputs=N mismatches=M xs=X" (N counts beats).
 `timescale 1ns/1ps
 module correlator_bank_iverilog_tb #(
   parameter integer N_IN = 1, N_OUT = 1,
@@ -22,22 +25,25 @@ module correlator_bank_iverilog_tb #(
   parameter integer WINDOW = 1005,
   parameter integer ENERGY_W = 41,
   parameter integer TIME_W = 40,
+  parameter integer CODE_W = 4,
   parameter [PERIOD*LO_W-1:0]     LO_COS = 0,
   parameter [PERIOD*LO_W-1:0]     LO_SIN = 0,
   parameter [TAPS*TAP_W-1:0]      TAP_VALUES = 0,
   parameter [CODES*CHIPS-1:0]     CODE_BITS = 0,
   parameter [CODES*WEIGHT_W-1:0]  WEIGHTS = 0
 ) ();
-  localparam integer OUT_BITS = CODES*WEIGHTED_W + ENERGY_W + TIME_W + 2*CHIP_W + 2*CODES*CORR_W;
+  localparam integer OUT_BITS = WEIGHTED_W + CODE_W + 1 + ENERGY_W + TIME_W + 2*CHIP_W + 2*CORR_W;
   reg clk = 1'b0, rst = 1'b1;
   reg [DATA_W-1:0] s_data = 0;
   reg s_valid = 1'b0, m_ready = 1'b0;
   wire s_ready, m_valid;
-  wire [CODES*WEIGHTED_W-1:0] m_weighted;
+  wire [WEIGHTED_W-1:0] m_weighted;
+  wire [CODE_W-1:0] m_code;
+  wire m_last;
   wire [ENERGY_W-1:0] m_energy;
   wire [TIME_W-1:0] m_index;
   wire signed [CHIP_W-1:0] m_chip_re, m_chip_im;
-  wire [CODES*CORR_W-1:0] m_corr_re, m_corr_im;
+  wire signed [CORR_W-1:0] m_corr_re, m_corr_im;
   correlator_bank #(
     .DATA_W(DATA_W),
     .DATA_FRAC(DATA_FRAC),
@@ -65,6 +71,7 @@ module correlator_bank_iverilog_tb #(
     .WINDOW(WINDOW),
     .ENERGY_W(ENERGY_W),
     .TIME_W(TIME_W),
+    .CODE_W(CODE_W),
     .LO_COS(LO_COS),
     .LO_SIN(LO_SIN),
     .TAP_VALUES(TAP_VALUES),
@@ -72,7 +79,8 @@ module correlator_bank_iverilog_tb #(
     .WEIGHTS(WEIGHTS)
   ) dut (
     .clk(clk), .rst(rst), .s_data(s_data), .s_valid(s_valid), .s_ready(s_ready),
-    .m_valid(m_valid), .m_ready(m_ready), .m_weighted(m_weighted), .m_energy(m_energy),
+    .m_valid(m_valid), .m_ready(m_ready), .m_weighted(m_weighted), .m_code(m_code),
+    .m_last(m_last), .m_energy(m_energy),
     .m_index(m_index), .m_chip_re(m_chip_re), .m_chip_im(m_chip_im),
     .m_corr_re(m_corr_re), .m_corr_im(m_corr_im));
 
@@ -80,7 +88,8 @@ module correlator_bank_iverilog_tb #(
   reg [OUT_BITS-1:0] vout [0:N_OUT-1];
   reg [1023:0] fin, fout;
   integer in_i = 0, out_i = 0, mism = 0, xs = 0, cyc = 0;
-  wire [OUT_BITS-1:0] got = {m_corr_im, m_corr_re, m_chip_im, m_chip_re, m_index, m_energy, m_weighted};
+  wire [OUT_BITS-1:0] got = {m_corr_im, m_corr_re, m_chip_im, m_chip_re, m_index, m_energy, m_last,
+                             m_code, m_weighted};
 
   always #5 clk = ~clk;
 
@@ -97,11 +106,11 @@ module correlator_bank_iverilog_tb #(
 
   always @(posedge clk) if (!rst) begin
     cyc <= cyc + 1;
-    if ((^{s_ready, m_valid, got}) === 1'bx) xs = xs + 1;
+    if ((^{s_ready, m_valid}) === 1'bx || (m_valid && (^got) === 1'bx)) xs = xs + 1;
     if (s_valid && s_ready) in_i = in_i + 1;
     if (m_valid && m_ready) begin
       if (got !== vout[out_i]) begin
-        if (mism < 5) $display("mismatch at output %0d: got %h expected %h", out_i, got, vout[out_i]);
+        if (mism < 5) $display("mismatch at beat %0d: got %h expected %h", out_i, got, vout[out_i]);
         mism = mism + 1;
       end
       out_i = out_i + 1;

@@ -1,5 +1,8 @@
 // rtl/correlator_bank.v against CorrelatorBankFixed, bit for bit, on every decimated output:
-// Q_j of every code, E, the sample index, F_q (chip filter) and C_q of every code.
+// Q_j of every code, E, the sample index, F_q (chip filter) and C_q of every code. The bank
+// sends an output as a group of CODES beats (docs: notes/serial.md): the testbench gathers
+// them and checks the framing (m_code = j, m_last on the last beat only, E / n / F equal on
+// every beat of a group) and that a beat does not change while m_valid && !m_ready.
 // Inputs: the default design's filtered received bursts of every Gold4 code at 100, 550 and
 // 1000 mm with and without noise, full-scale worst-case inputs and random noise, with random
 // s_valid gaps, random m_ready back-pressure and resets in the middle of a stream. Also the
@@ -39,15 +42,6 @@ const ReceiverDesign& design() {
   return d;
 }
 
-template <std::size_t N>
-std::uint64_t bits_of(const VlWide<N>& w, int lo, int width) {
-  std::uint64_t r = 0;
-  for (int b = 0; b < width; ++b) {
-    const int i = lo + b;
-    r |= static_cast<std::uint64_t>((w[static_cast<std::size_t>(i / 32)] >> (i % 32)) & 1u) << b;
-  }
-  return r;
-}
 std::int64_t sext(std::uint64_t v, int width) {
   const std::uint64_t m = std::uint64_t{1} << (width - 1);
   return static_cast<std::int64_t>((v ^ m) - m);
@@ -58,6 +52,56 @@ struct Output {
   std::uint64_t energy = 0, index = 0;
   std::int64_t chip_re = 0, chip_im = 0;
   std::vector<std::int64_t> corr_re, corr_im;
+};
+
+// One beat of the m_* stream (code j of one output).
+struct Beat {
+  std::uint64_t q = 0, code = 0, energy = 0, index = 0;
+  bool last = false;
+  std::int64_t chip_re = 0, chip_im = 0, corr_re = 0, corr_im = 0;
+  bool operator==(const Beat&) const = default;
+};
+
+// Gathers the beats of a group into an Output and checks the framing.
+class GroupCollector {
+ public:
+  explicit GroupCollector(std::size_t codes) : codes_(codes) {}
+  void clear() { out_ = Output{}; }
+  // Adds a taken beat; returns a framing error ("" if none); *done when the group is complete.
+  std::string add(const Beat& b, bool* done) {
+    *done = false;
+    const std::size_t j = out_.q.size();
+    std::ostringstream os;
+    if (b.code != j) os << "beat " << j << " of a group has m_code " << b.code;
+    else if (b.last != (j + 1 == codes_)) os << "beat " << j << " of a group has m_last " << b.last;
+    else if (j > 0 && (b.energy != out_.energy || b.index != out_.index || b.chip_re != out_.chip_re ||
+                       b.chip_im != out_.chip_im))
+      os << "beat " << j << ": energy/index/chip differ from beat 0 of the group";
+    if (!os.str().empty()) {
+      clear();  // resynchronise on the next group
+      return os.str();
+    }
+    if (j == 0) {
+      out_.energy = b.energy;
+      out_.index = b.index;
+      out_.chip_re = b.chip_re;
+      out_.chip_im = b.chip_im;
+    }
+    out_.q.push_back(b.q);
+    out_.corr_re.push_back(b.corr_re);
+    out_.corr_im.push_back(b.corr_im);
+    *done = b.last;
+    return "";
+  }
+  Output take() {
+    Output o = std::move(out_);
+    clear();
+    return o;
+  }
+
+ private:
+  std::size_t codes_;
+  Output out_;
 };
 
 // The model's decimated outputs for a stream from reset.
@@ -143,20 +187,19 @@ class BankSim {
     top_->rst = 0;
     top_->eval();
   }
-  Output read() const {
-    const auto& l = design().layout;
+  Beat read() const {
     const auto& c = design().config.correlator;
-    Output o;
-    for (int j = 0; j < l.codes; ++j) {
-      o.q.push_back(bits_of(top_->m_weighted, j * l.weighted_bits, l.weighted_bits));
-      o.corr_re.push_back(sext(bits_of(top_->m_corr_re, j * c.corr_bits, c.corr_bits), c.corr_bits));
-      o.corr_im.push_back(sext(bits_of(top_->m_corr_im, j * c.corr_bits, c.corr_bits), c.corr_bits));
-    }
-    o.energy = top_->m_energy;
-    o.index = top_->m_index;
-    o.chip_re = sext(top_->m_chip_re, c.chip_bits);
-    o.chip_im = sext(top_->m_chip_im, c.chip_bits);
-    return o;
+    Beat b;
+    b.q = top_->m_weighted;
+    b.code = top_->m_code;
+    b.last = top_->m_last != 0;
+    b.energy = top_->m_energy;
+    b.index = top_->m_index;
+    b.chip_re = sext(top_->m_chip_re, c.chip_bits);
+    b.chip_im = sext(top_->m_chip_im, c.chip_bits);
+    b.corr_re = sext(top_->m_corr_re, c.corr_bits);
+    b.corr_im = sext(top_->m_corr_im, c.corr_bits);
+    return b;
   }
   std::uint64_t cycles() const { return time_ / 2; }
 
@@ -224,8 +267,13 @@ void run(BankSim& sim, const std::vector<std::int64_t>& y, const RunOpts& o, std
   std::size_t in = 0, k = 0;
   bool presenting = false;
   std::uint64_t guard = 0;
-  Output held;
+  Beat held;
   bool holding = false;
+  GroupCollector groups(static_cast<std::size_t>(design().layout.codes));
+  auto fail = [&](const std::string& msg) {
+    ++g_totals.mismatches;
+    if (g_totals.first.empty()) g_totals.first = what + ": " + msg;
+  };
   const std::uint64_t max_cycles = 200 * y.size() + 10000;
   while (in < seg.size() || k < exp.size()) {
     auto& t = sim.top();
@@ -239,6 +287,7 @@ void run(BankSim& sim, const std::vector<std::int64_t>& y, const RunOpts& o, std
       k = 0;
       presenting = false;
       holding = false;
+      groups.clear();
       did_reset = true;
       continue;
     }
@@ -247,26 +296,26 @@ void run(BankSim& sim, const std::vector<std::int64_t>& y, const RunOpts& o, std
     t.s_data = static_cast<std::uint16_t>(in < seg.size() ? seg[in] : 0) & 0xffffu;
     t.m_ready = u(rng) >= o.stall ? 1 : 0;
     t.eval();
+    if (holding && !t.m_valid) fail("m_valid dropped before the beat was taken");
     if (t.m_valid) {
-      const Output g = sim.read();
-      if (holding && !compare(held, g).empty()) {
-        ++g_totals.mismatches;
-        if (g_totals.first.empty()) g_totals.first = what + ": output changed while m_valid && !m_ready";
-      }
-      held = g;
+      const Beat b = sim.read();
+      if (holding && !(held == b)) fail("beat changed while m_valid && !m_ready");
+      held = b;
       holding = !t.m_ready;
+      bool done = false;
       if (t.m_ready) {
+        const std::string framing = groups.add(b, &done);
+        if (!framing.empty()) fail("output " + std::to_string(k) + ": " + framing);
+      }
+      if (done) {
+        const Output g = groups.take();
         if (k >= exp.size()) {
-          ++g_totals.mismatches;
-          if (g_totals.first.empty()) g_totals.first = what + ": more outputs than the model";
+          fail("more outputs than the model");
         } else {
           const std::string diff = compare(exp[k], g);
           if (!diff.empty()) {
-            ++g_totals.mismatches;
-            if (g_totals.first.empty()) {
-              g_totals.first = what + ": output " + std::to_string(k) + " (input sample " +
-                               std::to_string(exp[k].index) + "): first stage differing: " + diff;
-            }
+            fail("output " + std::to_string(k) + " (input sample " + std::to_string(exp[k].index) +
+                 "): first stage differing: " + diff);
           }
         }
         ++k;
@@ -364,14 +413,16 @@ TEST(CorrelatorBankRtl, BitExactOnCodedBurstsAndWorstCase) {
   EXPECT_GT(g_totals.outputs, g_totals.inputs / static_cast<std::uint64_t>(2 * d.layout.decimation));
 }
 
-// Throughput at the default configuration: one input every 6 clocks (5 MS/s at 30 MHz), output
-// always taken. The bank must accept every sample on the clock it is presented (never stall the
-// stream) and still match the model on every output.
+// Throughput at the default configuration: one input every 6 clocks (5 MS/s at 30 MHz). The
+// bank must accept every sample on the clock it is presented (never stall the stream) and
+// still match the model on every output, both with the output always taken and with a
+// consumer like the peak detector: it takes the beats of a group one per clock, then is busy
+// (m_ready low) for kBusy clocks after each group's last beat (~100 clocks per group).
 TEST(CorrelatorBankRtl, SustainsOneSampleEverySixClocks) {
   const auto& d = design();
   ASSERT_EQ(d.layout.decimation, 20) << "the throughput target is for the default configuration";
   constexpr int kClocksPerSample = 6;
-  BankSim sim;
+  constexpr int kBusy = 91;
   std::vector<std::int64_t> y;
   for (std::size_t j : {0u, 4u, 8u}) {  // three coded bursts back to back
     std::size_t arrival = 0;
@@ -380,42 +431,56 @@ TEST(CorrelatorBankRtl, SustainsOneSampleEverySixClocks) {
   }
   const auto exp = model_outputs(y);
   ASSERT_GT(exp.size(), 300u);
-  sim.reset();
-  auto& t = sim.top();
-  t.m_ready = 1;
-  std::size_t in = 0, k = 0, refused = 0, mism = 0;
-  std::string first;
-  std::uint64_t clk = 0, last_out_clk = 0;
-  const std::uint64_t limit = static_cast<std::uint64_t>(kClocksPerSample) * y.size() + 2000;
-  while ((in < y.size() || k < exp.size()) && clk < limit) {
-    const bool present = in < y.size() && clk % kClocksPerSample == 0;
-    t.s_valid = present ? 1 : 0;
-    t.s_data = static_cast<std::uint16_t>(present ? y[in] : 0) & 0xffffu;
-    t.eval();
-    if (present) {
-      if (t.s_ready) ++in; else ++refused;  // a refused sample is lost for a real-time ADC
-    }
-    if (t.m_valid) {
-      if (k < exp.size()) {
-        const std::string diff = compare(exp[k], sim.read());
-        if (!diff.empty() && ++mism == 1) first = "output " + std::to_string(k) + ": " + diff;
-      } else if (++mism == 1) {
-        first = "more outputs than the model";
+  for (int busy : {0, kBusy}) {
+    SCOPED_TRACE("consumer busy " + std::to_string(busy) + " clocks after each group");
+    BankSim sim;
+    sim.reset();
+    auto& t = sim.top();
+    GroupCollector groups(static_cast<std::size_t>(d.layout.codes));
+    std::size_t in = 0, k = 0, refused = 0, mism = 0;
+    std::string first;
+    std::uint64_t clk = 0, last_out_clk = 0;
+    int busy_left = 0;
+    const std::uint64_t limit = static_cast<std::uint64_t>(kClocksPerSample) * y.size() + 2000;
+    while ((in < y.size() || k < exp.size()) && clk < limit) {
+      const bool present = in < y.size() && clk % kClocksPerSample == 0;
+      t.s_valid = present ? 1 : 0;
+      t.s_data = static_cast<std::uint16_t>(present ? y[in] : 0) & 0xffffu;
+      t.m_ready = busy_left == 0 ? 1 : 0;
+      t.eval();
+      if (present) {
+        if (t.s_ready) ++in; else ++refused;  // a refused sample is lost for a real-time ADC
       }
-      ++k;
-      last_out_clk = clk;
+      if (busy_left > 0) --busy_left;
+      if (t.m_valid && t.m_ready) {
+        bool done = false;
+        const std::string framing = groups.add(sim.read(), &done);
+        if (!framing.empty() && ++mism == 1) first = "output " + std::to_string(k) + ": " + framing;
+        if (done) {
+          busy_left = busy;
+          if (k < exp.size()) {
+            const std::string diff = compare(exp[k], groups.take());
+            if (!diff.empty() && ++mism == 1) first = "output " + std::to_string(k) + ": " + diff;
+          } else if (++mism == 1) {
+            first = "more outputs than the model";
+          }
+          ++k;
+          last_out_clk = clk;
+        }
+      }
+      sim.tick();
+      ++clk;
     }
-    sim.tick();
-    ++clk;
+    std::printf("correlator_bank throughput (consumer busy %d clocks per group): %zu samples at 1 per"
+                " %d clocks, %zu refused, %zu outputs, last output %llu clocks after the last sample"
+                " was presented\n",
+                busy, in, kClocksPerSample, refused, k,
+                static_cast<unsigned long long>(last_out_clk - kClocksPerSample * (y.size() - 1)));
+    EXPECT_EQ(refused, 0u) << "the bank stalled the 5 MS/s stream";
+    EXPECT_EQ(in, y.size());
+    EXPECT_EQ(k, exp.size());
+    EXPECT_EQ(mism, 0u) << first;
   }
-  std::printf("correlator_bank throughput: %zu samples at 1 per %d clocks, %zu refused, %zu outputs,"
-              " last output %llu clocks after the last sample was presented\n",
-              in, kClocksPerSample, refused, k,
-              static_cast<unsigned long long>(last_out_clk - kClocksPerSample * (y.size() - 1)));
-  EXPECT_EQ(refused, 0u) << "the bank stalled the 5 MS/s stream";
-  EXPECT_EQ(in, y.size());
-  EXPECT_EQ(k, exp.size());
-  EXPECT_EQ(mism, 0u) << first;
 }
 
 std::string slurp(const std::string& path) {
@@ -459,6 +524,15 @@ struct Packer {
   }
 };
 
+// CODE_W of the .vc (the module's default, 4, while the generator does not pass it).
+int vc_code_bits() {
+  std::ifstream f(kVc);
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("-GCODE_W=", 0) == 0) return std::stoi(line.substr(9));
+  return 4;
+}
+
 // module iv_top instantiating the Icarus testbench with the generated parameters (.vc).
 std::string wrapper_from_vc(const std::string& tb_module, const std::vector<std::string>& extra) {
   std::ifstream f(kVc);
@@ -481,6 +555,8 @@ TEST(CorrelatorBankRtl, IcarusSimulationMatchesModel) {
   std::vector<std::int64_t> seg(y.begin() + static_cast<std::ptrdiff_t>(arrival - 300),
                                 y.begin() + static_cast<std::ptrdiff_t>(arrival + 1700));
   const auto exp = model_outputs(seg);
+  const int code_bits = vc_code_bits();
+  std::size_t beats = 0;
   const std::string dir = std::string(RANGING_TRACE_DIR) + "/iverilog_rtlbank/correlator_bank";
   std::filesystem::create_directories(dir);
   {
@@ -490,20 +566,26 @@ TEST(CorrelatorBankRtl, IcarusSimulationMatchesModel) {
       p.add(static_cast<std::uint64_t>(v), c.data_bits);
       vin << p.hex() << "\n";
     }
+    // one word per beat: {corr_im, corr_re, chip_im, chip_re, index, energy, last, code, weighted}
     for (const auto& o : exp) {
-      Packer p;
-      for (auto q : o.q) p.add(q, l.weighted_bits);
-      p.add(o.energy, l.energy_bits);
-      p.add(o.index, 40);
-      p.add(static_cast<std::uint64_t>(o.chip_re), c.chip_bits);
-      p.add(static_cast<std::uint64_t>(o.chip_im), c.chip_bits);
-      for (auto v : o.corr_re) p.add(static_cast<std::uint64_t>(v), c.corr_bits);
-      for (auto v : o.corr_im) p.add(static_cast<std::uint64_t>(v), c.corr_bits);
-      vout << p.hex() << "\n";
+      for (std::size_t j = 0; j < o.q.size(); ++j) {
+        Packer p;
+        p.add(o.q[j], l.weighted_bits);
+        p.add(j, code_bits);
+        p.add(j + 1 == o.q.size() ? 1u : 0u, 1);
+        p.add(o.energy, l.energy_bits);
+        p.add(o.index, 40);
+        p.add(static_cast<std::uint64_t>(o.chip_re), c.chip_bits);
+        p.add(static_cast<std::uint64_t>(o.chip_im), c.chip_bits);
+        p.add(static_cast<std::uint64_t>(o.corr_re[j]), c.corr_bits);
+        p.add(static_cast<std::uint64_t>(o.corr_im[j]), c.corr_bits);
+        vout << p.hex() << "\n";
+        ++beats;
+      }
     }
     std::ofstream w(dir + "/wrapper.v");
     w << wrapper_from_vc("correlator_bank_iverilog_tb",
-                         {".N_IN(" + std::to_string(seg.size()) + ")", ".N_OUT(" + std::to_string(exp.size()) + ")"});
+                         {".N_IN(" + std::to_string(seg.size()) + ")", ".N_OUT(" + std::to_string(beats) + ")"});
   }
   const std::string tb = std::string(RANGING_SOURCE_DIR) + "/tb/correlator_bank_iverilog_tb.v";
   const std::string log = dir + "/sim.log";
@@ -517,9 +599,9 @@ TEST(CorrelatorBankRtl, IcarusSimulationMatchesModel) {
   unsigned long outputs = 0, mism = 0, xs = 0;
   ASSERT_EQ(std::sscanf(out.c_str() + pos, "RESULT outputs=%lu mismatches=%lu xs=%lu", &outputs, &mism, &xs), 3)
       << out;
-  std::printf("correlator_bank (Icarus): %zu input samples, %lu outputs compared, %lu mismatches\n",
-              seg.size(), outputs, mism);
-  EXPECT_EQ(outputs, exp.size()) << out;
+  std::printf("correlator_bank (Icarus): %zu input samples, %lu beats (%zu outputs) compared, %lu mismatches\n",
+              seg.size(), outputs, exp.size(), mism);
+  EXPECT_EQ(outputs, beats) << out;
   EXPECT_EQ(mism, 0u) << out;
   EXPECT_EQ(xs, 0u) << out;
 }
