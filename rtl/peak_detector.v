@@ -1,23 +1,29 @@
 // peak_detector: streaming peak picking on the correlator bank's outputs, bit-exact to
 // PeakDetectorFixed (model/peak_detector.cpp).
 //
-// What it computes, per input beat {Q_j (CODES x WEIGHTED_W unsigned), E, n}:
-//   best = argmax_j Q_j (lowest j on ties), second = max_{j != best} Q_j   (sequential scan)
+// Input: the correlator bank's outputs as GROUPS of CODES beats (AXI4-Stream with tlast): beat
+// j = 0 .. CODES-1 carries Q_j (s_weighted, WEIGHTED_W unsigned); s_energy = E and s_index = n
+// are the group's (same on every beat); s_last marks beat CODES-1 and restarts the detector's
+// own beat counter (framing).
+//
+// What it computes, per group {Q_j, E, n}:
+//   best = argmax_j Q_j (lowest j on ties), second = max_{j != best} Q_j   (scanned per beat)
 //   norm = E >> ENERGY_SHIFT;  gate = Q_best >= THRESHOLD * max(norm,1) && norm >= MIN_NORM
-//   a pending candidate whose right neighbour is unknown takes Q_next = Q_code(this beat)
+//   a pending candidate whose right neighbour is unknown takes Q_next = Q_code(this group)
 //   if gate && (no candidate || Q_best * max(norm_cand,1) > Q_cand * max(norm,1)):
 //       candidate := {n, best, Q_prev, Q, second, norm}   (the best rho^2 = Q / norm so far)
 //   else if candidate && Q_next known && n - n_cand >= HOLDOFF: emit it
-//   Q_prev := this beat's Q vector
+//   Q_prev := this group's Q vector
 // An event: score  = min(2^SCORE_W-1, floor(Q / max(norm,1))),  margin = score - same(Q2),
 //   frac = clamp(trunc((Q_next-Q_prev) 2^FRAC_W / (2 (2Q - Q_prev - Q_next))), +-2^(FRAC_W-1)),
 //   0 when the denominator is <= 0; arrival = n 2^FRAC_W + DECIM frac (signed).
 //
 // Architecture (sequential, one SB_MAC16, one EBR-inferred memory):
-//  - The beat is captured into a shift register; the scan looks at its bottom word only and
-//    shifts by WEIGHTED_W per clock (no CODES:1 multiplexer). Each word is also written into a
-//    2 x 2^clog2(CODES) x WEIGHTED_W memory (ping-pong by beat parity: 3 EBR at 48 bits), from
-//    which Q_prev = Q_best(previous beat) is read once after the scan.
+//  - Scan: each beat is compared with the running best / second as it arrives (one beat per
+//    clock while s_ready; the first beat of a group loads best and clears second), and written
+//    into a 2 x 2^clog2(CODES) x WEIGHTED_W memory (ping-pong by group parity: 3 EBR at 48
+//    bits), from which Q_prev = Q_best(previous group) is read once after the scan. No beat or
+//    group is captured in DFFs.
 //  - Both exact tests are D = A1*B1 - A2*B2 on one 16x16 multiplier (registered operands and
 //    product), gate: A1*B1 = Q_best*1, A2*B2 = THRESHOLD*norm1; rho^2 test: Q_best*norm1_cand
 //    - Q_cand*norm1. Partial products are summed column by column (16-bit digits, i+j = k) in
@@ -37,24 +43,34 @@
 //      gives 0. Both rules equal the model's floor + min(cap) / trunc + clamp for every input.
 //  - dQ = Q_next - Q_prev and den = 4Q - 2(Q_prev + Q_next) are formed in two clocks (one
 //    adder each per clock) in the divider's registers.
+//  - Output: the event is presented in S_OUT straight from the registers that computed it
+//    (code from the candidate, score from sc1, margin = sc1 - second score on one 16-bit
+//    subtractor, arrival = n 2^FRAC_W + DECIM frac written into the divisor register dv_d in the
+//    last divider step); the detector stays in S_OUT (s_ready low) until m_ready.
 // Bit growth: MAC accumulator 36 + clog2(NA+NB) bits signed (sum of <= 2 min(NA,NB) products
-// of 32 bits plus the carried-in column); divider registers WEIGHTED_W+3 bits; quotients as
-// above. No rounding; nothing can overflow.
-// Latency / throughput (CODES=9, 48-bit Q, 29-bit norm: NA=3, NB=2 digits): a beat takes
-// 1 + CODES + (2 NA NB + 3) [gate] + (2 NA NB + 3) [rho^2 test, only when the gate passes and a
-// candidate exists] + 1 = 41 cycles at most; an event adds 2 + FRAC_W + 1 + 2 (SCORE_W + 2) + 1
-// = 48 cycles, so a beat with an event is done in <= 89 cycles (measured by tb_peak_detector) <
-// the 120 between the bank's outputs (DECIM 20 x 6 clocks): s_ready is high whenever the bank
-// presents a beat. s_ready stays low while a beat or an event is processed and until the event
-// is in the output register (m_ready back-pressure stalls the bank; nothing is lost).
+// of 32 bits plus the carried-in column); divider registers max(WEIGHTED_W+3, norm bits+1,
+// arrival bits+1); DECIM * frac in FRAC_W+2+clog2(DECIM+1) bits; quotients as above. No
+// rounding; nothing can overflow.
+// Latency / throughput (CODES=9, 48-bit Q, 29-bit norm: NA=3, NB=2 digits): a group takes
+// CODES clocks of beats (one per clock, fewer if s_valid has gaps) + (2 NA NB + 3) [gate] +
+// (2 NA NB + 3) [rho^2 test, only when the gate passes and a candidate exists] + 1 = 40 clocks
+// at most; an event adds 2 + FRAC_W + 1 + 2 (SCORE_W + 2) + 1 = 48 clocks, so a group with an
+// event is done in <= 88 clocks after its first beat (measured by tb_peak_detector: 88 on the
+// edge-case stream, 73 on the paced coded stream) < the 120 between the bank's groups (DECIM
+// 20 x 6 clocks): s_ready is high whenever the bank starts a group and stays high for its
+// CODES beats. s_ready is low while a group's tests or an event are processed and while the
+// event waits for m_ready (back-pressure stalls the bank; nothing is lost).
 // Streams: valid/ready with AXI4-Stream rules (m_* stable while m_valid && !m_ready).
-// Reset: synchronous, active high, clears the control state, the candidate and the output
-// valid; the previous-beat vector reads as zeros until a beat has been taken.
-// Resources (yosys synth_ice40 -dsp, default configuration, /work/notes/module_stat.sh):
-// 2025 SB_LUT4, 1177 DFF, 1 SB_MAC16, 3 SB_RAM40_4K. 432 DFF and ~432 LUT4 of these are the
-// beat's shift register (load / shift multiplexer); the rest is mostly the divider (5 sources
-// into its 51-bit remainder, 4 wide adders for dQ, den, |dQ| and the step), the MAC digit
-// multiplexers and accumulator, the scan comparators and the 4 candidate words.
+// Reset: synchronous, active high, clears only the control state (state, beat counter,
+// candidate and MAC flags); data registers have no reset. The previous-group vector reads as
+// zeros until a group has been taken.
+// Resources (yosys 0.23 synth_ice40 -dsp of peak_detector alone with the default parameters of
+// generated/default/rtl/peak_detector.vc; module_stat.sh needs the regenerated receiver_top):
+// 1624 SB_LUT4, 660 DFF, 1 SB_MAC16, 3 SB_RAM40_4K (was 2046 / 1177 measured the same way with
+// the parallel input). The LUTs are mostly the divider (5 sources into its 51-bit remainder, 4
+// wide adders for dQ, den, |dQ| and the step; 3 sources into dv_d), the MAC digit multiplexers
+// and accumulator, the two scan comparators, the holdoff test (n - n_cand >= HOLDOFF) and the
+// arrival adder.
 `default_nettype none
 
 module peak_detector #(
@@ -87,10 +103,11 @@ module peak_detector #(
   localparam integer KW    = $clog2(NK + 1);
   localparam integer IW    = $clog2(NA + 1);
   localparam integer AW    = 36 + $clog2(NA + NB);                // MAC accumulator
-  localparam integer W     = (QW + 3 > NW + 1) ? QW + 3 : NW + 1;  // divider registers
+  localparam integer ARR_W = TIME_W + FRAC_W + 1;
+  localparam integer W0    = (QW + 3 > NW + 1) ? QW + 3 : NW + 1;
+  localparam integer W     = (W0 > ARR_W) ? W0 : ARR_W + 1;       // divider registers (and arrival)
   localparam integer KM    = (SCORE_W + 1 > FRAC_W) ? SCORE_W + 1 : FRAC_W;  // quotient bits
   localparam integer CW    = $clog2(KM + 1);
-  localparam integer ARR_W = TIME_W + FRAC_W + 1;
   localparam integer FR_W  = FRAC_W + 2;                          // signed fraction
   localparam integer HOLDOFF_I = HOLDOFF;
   localparam [TIME_W-1:0] HOLD_T = {{(TIME_W-32){1'b0}}, HOLDOFF_I[31:0]};  // TIME_W >= 32
@@ -222,23 +239,26 @@ module peak_detector #(
   wire emit = c_valid && (c_has_next || hn_now) && since >= HOLD_T;
 
   // output: held in S_OUT (the registers it is computed from do not change there)
-  reg [ARR_W-1:0]    o_arrival;
   localparam integer DECIM_I = DECIM;
-  localparam signed [ARR_W-1:0] DECIM_A = {{(ARR_W-32){1'b0}}, DECIM_I[31:0]};
+  localparam integer DW = $clog2(DECIM + 1);
+  localparam integer FD_W = FR_W + DW;                      // DECIM * frac, signed
+  localparam [DW-1:0] DECIM_D = DECIM_I[DW-1:0];
   wire signed [FR_W-1:0] frac = ev_neg ? -$signed(fmag) : $signed(fmag);
-  wire signed [ARR_W-1:0] frac_x = {{(ARR_W-FR_W){frac[FR_W-1]}}, frac};
-  // DECIM * frac as shifts and adds of the constant's set bits (no multiplier cell)
-  function [ARR_W-1:0] times_decim;
-    input [ARR_W-1:0] v;
+  wire [FD_W-1:0] frac_x = {{DW{frac[FR_W-1]}}, frac};
+  // DECIM * frac as shifts and adds of the constant's set bits (no multiplier cell), only as
+  // wide as the product can be
+  function [FD_W-1:0] times_decim;
+    input [FD_W-1:0] v;
     integer b;
     begin
-      times_decim = {ARR_W{1'b0}};
-      for (b = 0; b < 31; b = b + 1)
-        if (DECIM_A[b]) times_decim = times_decim + (v << b);
+      times_decim = {FD_W{1'b0}};
+      for (b = 0; b < DW; b = b + 1)
+        if (DECIM_D[b]) times_decim = times_decim + (v << b);
     end
   endfunction
-  wire [ARR_W-1:0] frac_d = times_decim(frac_x);
-  wire signed [ARR_W-1:0] arrival = $signed({1'b0, c_n, {FRAC_W{1'b0}}}) + $signed(frac_d);
+  wire [FD_W-1:0] frac_d = times_decim(frac_x);
+  wire signed [ARR_W-1:0] arrival = $signed({1'b0, c_n, {FRAC_W{1'b0}}})
+                                  + $signed({{(ARR_W-FD_W){frac_d[FD_W-1]}}, frac_d});
 
   assign s_ready = (state == S_IDLE);
 
@@ -371,7 +391,8 @@ module peak_detector #(
       end
       S_NEXT: begin
         dv_cnt <= {CW{1'b0}};
-        dv_d <= {{(W-NW){1'b0}}, c_norm1};
+        // the last step: dv_d holds the event's arrival while it is presented (S_OUT)
+        dv_d <= (dsel == 2'd2) ? {{(W-ARR_W){arrival[ARR_W-1]}}, arrival} : {{(W-NW){1'b0}}, c_norm1};
         if (dsel == 2'd0) begin
           if (FRAC_W > 0 && den_pos)
             fmag <= dv_q[KF1] ? HALF : fq;
@@ -383,8 +404,6 @@ module peak_detector #(
           dsel <= 2'd2;
           dv_r <= {{(W-QW-1){1'b0}}, q2_hi};
           dv_q <= q2_lo;
-        end else begin
-          o_arrival <= arrival;
         end
       end
       default: ;
@@ -393,7 +412,7 @@ module peak_detector #(
 
   assign m_valid   = (state == S_OUT);
   assign m_code    = code_x[CODE_W-1:0] + 1'b1;
-  assign m_arrival = o_arrival;
+  assign m_arrival = dv_d[ARR_W-1:0];
   assign m_score   = sc1;
   assign m_margin  = sc1 - score_now;
 endmodule

@@ -1,10 +1,13 @@
 // rtl/peak_detector.v against PeakDetectorFixed, bit for bit: the detector is driven with the
-// model bank's outputs (Q_j, E, n) of streams of filtered Gold4 bursts at many distances, with
-// random s_valid gaps, random m_ready back-pressure and a reset in the middle of a stream;
+// model bank's outputs (Q_j, E, n) of streams of filtered Gold4 bursts at many distances, each
+// output as a group of CODES beats (s_weighted = Q_j, s_last on j = CODES-1, E and n on every
+// beat), with random s_valid gaps inside and between groups, random m_ready back-pressure and a
+// reset in the middle of a stream (between groups);
 // every event (code, arrival, score, margin) must equal the model's, none lost or duplicated
 // (the model's flush() at the end of a stream is not part of the hardware and not compared).
-// A paced run at the default configuration presents one beat every DECIM x 6 clocks (the bank's
-// rate) with m_ready = 1 and asserts the detector is ready for every beat (it never stalls the
+// A paced run at the default configuration starts one group every DECIM x 6 clocks (the bank's
+// rate), its beats on consecutive clocks, with m_ready = 1, and asserts the detector accepts
+// every beat on its first clock and every group before the next is due (it never stalls the
 // bank) while the events still match the model. Synthetic beats drive the divider and the
 // cross-product comparison to their edges (score exactly at / just below the cap, fraction
 // exactly +-1/2, zero and negative parabola denominators, equal rho^2, 48-bit operands); their
