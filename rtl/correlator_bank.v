@@ -5,7 +5,7 @@
 //   B[n]   = q_mix(y[n] * LO_COS[n mod P]), q_mix(y[n] * -LO_SIN[n mod P])   (mixer)
 //   acc    = sum_{i<P} B[n-i]             moving sum over one carrier cycle, DEC_W, exact
 //   E[n]   = sum_{i<WINDOW} y[n-i]^2      running energy, ENERGY_W unsigned, exact
-// and after every DECIM-th input (one output beat):
+// and after every DECIM-th input (one output group of CODES beats, j = 0 .. CODES-1):
 //   Bd[k]  = acc                          (decimation)
 //   F[k]   = q_chip(sum_{i<TAPS} g[i] Bd[k-i])            chip filter, FIR_W exact accumulator
 //   C_j[k] = sum_{m<CHIPS} s_j(m) F[k - (CHIPS-1-m) CHIP_STEP]   combiner, exact, per code j
@@ -29,9 +29,9 @@
 //     (registered operands and product) does y*cos, y*-sin, y*y and y_old*y_old; the B and y
 //     histories are memories; E += y^2 and E -= y_old^2 share one adder. After the last
 //     input of a decimation group, the hand-off clock (which also accepts the next input,
-//     so it costs no extra cycle unless the back end is more than one output behind; then
-//     the front end waits) writes Bd = acc into the Bd history and pushes E into a 2-entry
-//     queue.
+//     so it costs no extra cycle unless the back end is more than one output behind or
+//     three outputs' E are unread; then the front end waits) writes Bd = acc into the Bd
+//     history and pushes E into the 3-entry energy ring.
 //   Back end: ONE unsigned 16x16 multiplier (registered limb operands, registered product)
 //     in sign-magnitude: every wide operand is split into 16-bit limbs of its magnitude, the
 //     limb product is shifted by 16 (la+lb) and added or subtracted (one adder: the product
@@ -45,12 +45,26 @@
 //     Combiner (no multiplier): per output, one round per code; each round reads the CHIPS
 //       taps F[k - (CHIPS-1-m) CHIP_STEP] from the F history (one per clock) into two
 //       COMB_W accumulators (re, im; C +- F on one adder each), then quantizes them into
-//       the Cq registers (and code j's m_corr slots) and clears them: CHIPS + 2 clocks per
-//       round, (CHIPS + 2) CODES per output (81 at the defaults, within the 120).
+//       the Cq registers (and code j's word of the group buffer's Cq memory) and clears
+//       them: CHIPS + 2 clocks per round, (CHIPS + 2) CODES per output (81 at the
+//       defaults, within the 120).
 //     SQ: Re^2 + Im^2 per code (2 ceil(CORR_W/16)^2 limb products) into P.
-//     W: P * w_j (ceil(2 CORR_W/16) x ceil(WEIGHT_W/16) limb products), written straight
-//       into code j's slot of m_weighted.
+//     W: P * w_j (ceil(2 CORR_W/16) x ceil(WEIGHT_W/16) limb products), the last sum
+//       written straight into code j's word of the group buffer's Q memory.
 //     The FIR of output k+1 runs in the clocks the SQ/W engines of output k leave free.
+//   Output: a ping-pong group buffer, two synchronous-read memories (Q: WEIGHTED_W, Cq:
+//     2 CORR_W wide) of 2 banks x 2^ceil(log2 CODES) words, address {bank, j}. The back end
+//     writes one bank while the consumer reads the other; a finished group is presented
+//     beat by beat, the read address looking one beat ahead (the address of the beat
+//     shown next clock), so m_weighted / m_corr are the memories' output registers and do
+//     not change while a beat waits. The back end starts a new group only when a bank is
+//     free (not while two finished groups are unread). E of each group waits in a 3-entry
+//     ring from the hand-off until the consumer takes the group's last beat; n is a
+//     counter advanced by DECIM at that beat; F (debug) is one register pair per bank.
+//     The memories are marked no_rw_check: a read of the word being written can only
+//     happen on a word the consumer does not look at (a bank with no finished group, or a
+//     history entry outside the window in use), so yosys need not emulate read-old-data
+//     (it cost a registered copy of the write data and a bypass mux per memory).
 //   Limb products per output at the defaults (DEC_W 23, TAP_W 16, CORR_W 16, TAPS 20,
 //     CODES 9): FIR 2*20*2 = 80, SQ 9*2 = 18, W 9*2 = 18: 116 <= 120 = 6 DECIM clocks.
 // Throughput: 6 clocks per input sample when the back end keeps up, i.e. when
@@ -58,25 +72,41 @@
 //   ceil(WEIGHT_W/16)) <= 6 DECIM (plus a few clocks of pipeline slack); otherwise the back
 //   end sets the pace (the front end waits at a decimation point). 6 clocks at the defaults
 //   (tested: one input every 6 clocks is never refused).
-// Latency: last input of a decimation group to m_valid: about 2 TAPS ceil(DEC_W/16)
-//   ceil(TAP_W/16) + 5 (FIR) + (CHIPS+2) CODES + 8 clocks when idle (~175 at the
-//   defaults), more when the previous output's SQ/W work overlaps.
+// Latency: last input of a decimation group to the group's first beat: about 2 TAPS
+//   ceil(DEC_W/16) ceil(TAP_W/16) + 5 (FIR) + (CHIPS+2) CODES + 8 clocks when idle (~175
+//   at the defaults), more when the previous output's SQ/W work overlaps; the last beat
+//   CODES-1 clocks later when the consumer takes one beat per clock. Two finished groups
+//   are buffered, so a consumer that takes up to about 6 DECIM clocks per group on average
+//   does not slow the front end; tested at the defaults: one input every 6 clocks is never
+//   refused while the consumer takes a group's beats one per clock and then is busy 91
+//   clocks (100 clocks per group; measured outside the tests: still none refused at 119
+//   clocks per group, 120 refused of 8700 at 122).
 // Multipliers (synth_ice40 -dsp): 2 SB_MAC16 at the defaults (front 16x16 signed, back 16x16
 //   unsigned). Memories (synchronous read, no reset, EBR): B history PERIOD x 2 MIX_W,
 //   y history WINDOW x DATA_W (y, not y^2: y_old^2 is recomputed), Bd history (TAPS+1) x
-//   2 DEC_W, F history ((CHIPS-1) CHIP_STEP + 1) x 2 CHIP_W. Histories are cleared lazily:
-//   a fill flag/counter per history masks entries not written since reset to zero, so after
-//   reset the outputs equal a fresh model's without a clearing pass.
-// Resources (yosys synth_ice40 -dsp, defaults, /work/notes/module_stat.sh correlator_bank):
-//   2 SB_MAC16, 13 SB_RAM40_4K, 1847 SB_LUT4, 1860 DFF (of which 288 are the m_corr_re/im
-//   debug registers, 432 the m_weighted bus; flattened with m_corr/m_chip unconnected:
-//   1836 SB_LUT4, 1532 DFF). Was 7 / 13 / 4217 / 2520 before this design, 2 / 13 / 2901 /
-//   1943 with two codes per combiner round and separate add/subtract paths.
+//   2 DEC_W, F history ((CHIPS-1) CHIP_STEP + 1) x 2 CHIP_W, group buffer Q and Cq (above).
+//   Histories are cleared lazily: a fill flag/counter per history masks entries not
+//   written since reset to zero, so after reset the outputs equal a fresh model's without a
+//   clearing pass. The group buffer is not cleared: its words are undefined while m_valid
+//   is low (AXI-Stream allows it).
+// Resources (yosys 0.23 synth_ice40 -dsp, defaults):
+//   /work/notes/module_stat.sh correlator_bank (-noflatten, debug outputs kept):
+//     2 SB_MAC16, 18 SB_RAM40_4K (2 of them the Cq debug memory), 1799 SB_LUT4, 883 DFF;
+//   flattened with m_corr / m_chip unconnected (as in the system):
+//     2 SB_MAC16, 16 SB_RAM40_4K, 1752 SB_LUT4, 803 DFF.
+//   Was 2 / 13 / 1847 / 1860 (flattened 1815 / 1532 measured the same way) with the
+//   parallel CODES x WEIGHTED_W output register, 7 / 13 / 4217 / 2520 before the
+//   shared-multiplier design.
 //
-// Streams: s_* one beat per input sample (s_ready high only when the front end is idle);
-// m_* one beat per decimated output; data stable while m_valid && !m_ready; the back end
-// does not start an output's combiner while the previous output is not taken (the FIR of the
-// next output may run; then the front end waits): no output is lost.
+// Streams (AXI4-Stream rules, data stable while valid && !ready):
+//   s_*: one beat per input sample (s_ready high only when the front end is idle).
+//   m_*: one group of CODES beats per decimated output, beat j carrying code j:
+//     m_weighted = Q_j, m_code = j, m_last = (j == CODES-1), m_corr_re/im = Cq_j (debug);
+//     m_energy = E, m_index = n (the input sample index of the output), m_chip_re/im = F_q
+//     (debug) are the group's and equal on all its beats. A group is presented only when
+//     complete; the next one follows without a gap when it is finished too. No output is
+//     lost: with both banks full the back end waits (the FIR of the next output may run;
+//     then the front end waits).
 // Reset: synchronous, active high; clears every register, counter, phase and fill flag.
 `default_nettype none
 
@@ -100,7 +130,7 @@ module correlator_bank #(
   parameter integer WINDOW = 1005,
   parameter integer ENERGY_W = 41,
   parameter integer TIME_W = 40,
-  parameter integer CODE_W = 4,
+  parameter integer CODE_W = 4,  // width of m_code, >= $clog2(CODES) (the detector's CODE_W)
   parameter [PERIOD*LO_W-1:0]     LO_COS = 0,
   parameter [PERIOD*LO_W-1:0]     LO_SIN = 0,
   parameter [TAPS*TAP_W-1:0]      TAP_VALUES = 0,
