@@ -98,7 +98,7 @@ std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::stri
   const auto& bank = find(mods, "correlator_bank");
   const auto& det = find(mods, "peak_detector");
   const auto in_w = sos.value("IN_W"), data_w = sos.value("DATA_W"), sections = sos.value("SECTIONS");
-  const auto codes = bank.value("CODES"), weighted_w = bank.value("WEIGHTED_W");
+  const auto weighted_w = bank.value("WEIGHTED_W");
   const auto energy_w = bank.value("ENERGY_W"), time_w = bank.value("TIME_W");
   const auto chip_w = bank.value("CHIP_W"), corr_w = bank.value("CORR_W");
   const auto code_w = det.value("CODE_W"), frac_w = det.value("FRAC_W"), score_w = det.value("SCORE_W");
@@ -114,7 +114,9 @@ std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::stri
      << " bits, rho^2), margin (" << score_w << " bits).\n"
         "// Back-pressure on m_axis stalls the pipeline back to s_axis_tready: no event is lost.\n"
         "// The dbg_* ports are the stage taps the testbenches compare with the golden model;\n"
-        "// each is valid on the cycle its *_valid strobe is high (a completed beat).\n"
+        "// each is valid on the cycle its *_valid strobe is high (a completed beat). The bank\n"
+        "// streams one beat per code: a decimated output is CODES beats, dbg_code = j (0-based)\n"
+        "// with dbg_last on the last; energy, index and chip are the group's on every beat.\n"
         "`default_nettype none\n\n"
         "module receiver_top (\n"
         "  input  wire clk,\n"
@@ -129,18 +131,22 @@ std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::stri
         "  output wire signed [" << data_w - 1 << ":0] dbg_filter_data,\n"
         "  output wire [" << sections * data_w - 1 << ":0] dbg_filter_sections,\n"
         "  output wire dbg_bank_valid,\n"
-        "  output wire [" << codes * weighted_w - 1 << ":0] dbg_weighted,\n"
+        "  output wire [" << weighted_w - 1 << ":0] dbg_weighted,\n"
+        "  output wire [" << code_w - 1 << ":0] dbg_code,\n"
+        "  output wire dbg_last,\n"
         "  output wire [" << energy_w - 1 << ":0] dbg_energy,\n"
         "  output wire [" << time_w - 1 << ":0] dbg_index,\n"
         "  output wire signed [" << chip_w - 1 << ":0] dbg_chip_re,\n"
         "  output wire signed [" << chip_w - 1 << ":0] dbg_chip_im,\n"
-        "  output wire [" << codes * corr_w - 1 << ":0] dbg_corr_re,\n"
-        "  output wire [" << codes * corr_w - 1 << ":0] dbg_corr_im\n"
+        "  output wire signed [" << corr_w - 1 << ":0] dbg_corr_re,\n"
+        "  output wire signed [" << corr_w - 1 << ":0] dbg_corr_im\n"
         ");\n\n"
         "  wire signed [" << data_w - 1 << ":0] filter_data;\n"
         "  wire filter_valid, filter_ready;\n"
         "  wire bank_valid, bank_ready;\n"
-        "  wire [" << codes * weighted_w - 1 << ":0] bank_weighted;\n"
+        "  wire [" << weighted_w - 1 << ":0] bank_weighted;\n"
+        "  wire [" << code_w - 1 << ":0] bank_code;\n"
+        "  wire bank_last;\n"
         "  wire [" << energy_w - 1 << ":0] bank_energy;\n"
         "  wire [" << time_w - 1 << ":0] bank_index;\n"
         "  wire [" << code_w - 1 << ":0] event_code;\n"
@@ -156,14 +162,16 @@ std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::stri
         "    .clk(clk), .rst(rst),\n"
         "    .s_data(filter_data), .s_valid(filter_valid), .s_ready(filter_ready),\n"
         "    .m_valid(bank_valid), .m_ready(bank_ready),\n"
-        "    .m_weighted(bank_weighted), .m_energy(bank_energy), .m_index(bank_index),\n"
+        "    .m_weighted(bank_weighted), .m_code(bank_code), .m_last(bank_last),\n"
+        "    .m_energy(bank_energy), .m_index(bank_index),\n"
         "    .m_chip_re(dbg_chip_re), .m_chip_im(dbg_chip_im),\n"
         "    .m_corr_re(dbg_corr_re), .m_corr_im(dbg_corr_im)\n"
         "  );\n\n"
         "  peak_detector #(\n" << instance_params(det) << "  ) u_detector (\n"
         "    .clk(clk), .rst(rst),\n"
         "    .s_valid(bank_valid), .s_ready(bank_ready),\n"
-        "    .s_weighted(bank_weighted), .s_energy(bank_energy), .s_index(bank_index),\n"
+        "    .s_weighted(bank_weighted), .s_last(bank_last),\n"
+        "    .s_energy(bank_energy), .s_index(bank_index),\n"
         "    .m_valid(m_axis_tvalid), .m_ready(m_axis_tready),\n"
         "    .m_code(event_code), .m_arrival(event_arrival),\n"
         "    .m_score(event_score), .m_margin(event_margin)\n"
@@ -173,6 +181,8 @@ std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::stri
         "  assign dbg_filter_data = filter_data;\n"
         "  assign dbg_bank_valid = bank_valid & bank_ready;\n"
         "  assign dbg_weighted = bank_weighted;\n"
+        "  assign dbg_code = bank_code;\n"
+        "  assign dbg_last = bank_last;\n"
         "  assign dbg_energy = bank_energy;\n"
         "  assign dbg_index = bank_index;\n\n"
         "endmodule\n\n`default_nettype wire\n";
@@ -200,7 +210,9 @@ std::string gtkw(const std::vector<HwModuleParams>& mods, const std::string& ori
      << analog("dbg_filter_data", sos.value("DATA_W"))
      << "@200\n-correlator bank\n@28\nTOP.receiver_top.dbg_bank_valid\n"
      << analog("dbg_chip_re", bank.value("CHIP_W")) << analog("dbg_chip_im", bank.value("CHIP_W"))
-     << "@22\n" << bus("dbg_energy", bank.value("ENERGY_W")) << bus("dbg_index", bank.value("TIME_W"))
+     << "@22\n" << bus("dbg_code", det.value("CODE_W")) << "@28\nTOP.receiver_top.dbg_last\n@22\n"
+     << bus("dbg_weighted", bank.value("WEIGHTED_W"))
+     << bus("dbg_energy", bank.value("ENERGY_W")) << bus("dbg_index", bank.value("TIME_W"))
      << "@200\n-events\n@28\nTOP.receiver_top.m_axis_tvalid\nTOP.receiver_top.m_axis_tready\n"
      << "@22\n" << bus("event_code", det.value("CODE_W"))
      << bus("event_arrival", bank.value("TIME_W") + det.value("FRAC_W") + 1)

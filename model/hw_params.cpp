@@ -150,7 +150,8 @@ std::vector<HwModuleParams> hardware_parameters(const ReceiverDesign& d) {
                  packed("LO_SIN", l.lo_sin, c.correlator.lo_bits),
                  packed("TAP_VALUES", l.taps_q, c.correlator.tap_bits),
                  packed("CODE_BITS", chips_flat, 1),
-                 packed("WEIGHTS", l.weights, c.correlator.weight_bits)};
+                 packed("WEIGHTS", l.weights, c.correlator.weight_bits),
+                 scalar("CODE_W", bits_for(l.codes))};  // m_code: j of the beat, 0-based
   out.push_back(bank);
 
   const PeakDetectorFixed det(c.detector, l, c.correlator);

@@ -98,7 +98,7 @@ module ranging_system #(
     .s_axis_tdata(sample), .s_axis_tvalid(sample_valid), .s_axis_tready(sample_ready),
     .m_axis_tdata(event_data), .m_axis_tvalid(event_valid), .m_axis_tready(event_ready),
     .dbg_filter_valid(), .dbg_filter_data(), .dbg_filter_sections(),
-    .dbg_bank_valid(), .dbg_weighted(), .dbg_energy(), .dbg_index(),
+    .dbg_bank_valid(), .dbg_weighted(), .dbg_code(), .dbg_last(), .dbg_energy(), .dbg_index(),
     .dbg_chip_re(), .dbg_chip_im(), .dbg_corr_re(), .dbg_corr_im()
   );
   /* verilator lint_on PINCONNECTEMPTY */

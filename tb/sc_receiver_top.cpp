@@ -192,6 +192,8 @@ int sc_main(int, char**) {
   sc_signal<PORT_T(dbg_index)> d6;
   sc_signal<PORT_T(dbg_chip_re)> d7, d8;
   sc_signal<PORT_T(dbg_corr_re)> d9, d10;
+  sc_signal<PORT_T(dbg_code)> d11;
+  sc_signal<PORT_T(dbg_last)> d12;
 
   Vreceiver_top dut("dut");
   dut.clk(clk);
@@ -213,6 +215,8 @@ int sc_main(int, char**) {
   dut.dbg_chip_im(d8);
   dut.dbg_corr_re(d9);
   dut.dbg_corr_im(d10);
+  dut.dbg_code(d11);
+  dut.dbg_last(d12);
 
   sc_fifo<std::int64_t> src_dut(64), src_model(64);
   sc_fifo<EventFixed> ev_dut(16), ev_model(static_cast<int>(expected) + 1);

@@ -142,13 +142,14 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
   tb << "`timescale 1ns/1ps\nmodule tb;\n  reg clk = 0, rst = 1;\n  always #5 clk = ~clk;\n"
      << "  reg [" << in_w - 1 << ":0] mem [0:" << n - 1 << "];\n  integer i = 0, fd, cyc = 0;\n"
      << "  wire ready, fv, bv, ev;\n  wire [" << data_w - 1 << ":0] fd_data;\n"
-     << "  wire [" << codes * qw - 1 << ":0] wq;\n  wire [" << ew - 1 << ":0] en;\n"
+     << "  wire [" << qw - 1 << ":0] wq;\n  wire [" << ew - 1 << ":0] en;\n  wire [" << code_w - 1 << ":0] bj;\n  wire bl;\n"
      << "  wire [" << tw - 1 << ":0] idx;\n  wire [" << cw - 1 << ":0] cre, cim;\n"
      << "  wire [" << event_w - 1 << ":0] evd;\n"
      << "  receiver_top dut(.clk(clk), .rst(rst), .s_axis_tdata(mem[i]), .s_axis_tvalid(i < " << n
      << " && !rst), .s_axis_tready(ready), .m_axis_tdata(evd), .m_axis_tvalid(ev), .m_axis_tready(1'b1),\n"
      << "    .dbg_filter_valid(fv), .dbg_filter_data(fd_data), .dbg_filter_sections(), .dbg_bank_valid(bv),\n"
-     << "    .dbg_weighted(wq), .dbg_energy(en), .dbg_index(idx), .dbg_chip_re(cre), .dbg_chip_im(cim),\n"
+     << "    .dbg_weighted(wq), .dbg_code(bj), .dbg_last(bl), .dbg_energy(en), .dbg_index(idx),\n"
+     << "    .dbg_chip_re(cre), .dbg_chip_im(cim),\n"
      << "    .dbg_corr_re(), .dbg_corr_im());\n"
      << "  initial begin\n    $readmemh(\"" << (work / "stim.hex").string() << "\", mem);\n"
      << "    fd = $fopen(\"" << (work / "out.txt").string() << "\", \"w\");\n"
@@ -156,7 +157,7 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
      << "  always @(posedge clk) if (!rst) begin\n"
      << "    cyc = cyc + 1;\n"
      << "    if (fv) $fwrite(fd, \"F %h\\n\", fd_data);\n"
-     << "    if (bv) $fwrite(fd, \"B %h %h %h %h %h\\n\", idx, en, cre, cim, wq);\n"
+     << "    if (bv) $fwrite(fd, \"B %h %h %h %h %h %h %h\\n\", idx, en, cre, cim, bj, bl, wq);\n"
      << "    if (ev) $fwrite(fd, \"E %h\\n\", evd);\n"
      << "    if (i < " << n << " && ready) i <= i + 1;\n"
      << "    if (i >= " << n << " && cyc > 0 && $time > 0 && (cyc > " << 64 * n + 20000 << ")) begin $fclose(fd); $finish; end\n"
@@ -179,6 +180,7 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
   std::ifstream out(work / "out.txt");
   std::string tag, line;
   std::size_t nf = 0, nb = 0, ne = 0;
+  int beat = 0;
   bool done = false;
   while (std::getline(out, line)) {
     std::istringstream ls(line);
@@ -190,18 +192,22 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
       ASSERT_EQ(sext(hex_bits(h, 0, data_w), data_w), filt[nf]) << "filter output, sample " << nf;
       ++nf;
     } else if (tag == "B") {
-      std::string hi, he, hr, hm, hq;
-      ls >> hi >> he >> hr >> hm >> hq;
+      std::string hi, he, hr, hm, hj, hl, hq;  // one beat per code
+      ls >> hi >> he >> hr >> hm >> hj >> hl >> hq;
       const std::uint64_t i = hex_bits(hi, 0, tw);
       ASSERT_LT(i, n);
       const BankState& b = bank[i];
       ASSERT_EQ(hex_bits(he, 0, ew), b.energy) << "energy at index " << i;
       ASSERT_EQ(sext(hex_bits(hr, 0, cw), cw), b.chip_re) << "chip filter (re) at index " << i;
       ASSERT_EQ(sext(hex_bits(hm, 0, cw), cw), b.chip_im) << "chip filter (im) at index " << i;
-      for (int j = 0; j < codes; ++j) {
-        ASSERT_EQ(hex_bits(hq, j * qw, qw), b.q[static_cast<std::size_t>(j)]) << "Q_" << j + 1 << " at index " << i;
+      const int j = static_cast<int>(hex_bits(hj, 0, code_w));
+      ASSERT_EQ(j, beat) << "beat order at index " << i;
+      ASSERT_EQ(hex_bits(hl, 0, 1) == 1, j == codes - 1) << "last flag at index " << i;
+      ASSERT_EQ(hex_bits(hq, 0, qw), b.q[static_cast<std::size_t>(j)]) << "Q_" << j + 1 << " at index " << i;
+      if (++beat == codes) {
+        beat = 0;
+        ++nb;
       }
-      ++nb;
     } else if (tag == "E") {
       std::string h;
       ls >> h;

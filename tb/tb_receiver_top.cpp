@@ -99,6 +99,7 @@ class Bench {
     bank_expect_.clear();
     event_expect_.clear();
     in_count_ = filt_count_ = bank_count_ = 0;
+    bank_beat_ = 0;
   }
 
   // Streams samples through; returns false (with a message) at the first mismatch.
@@ -177,28 +178,29 @@ class Bench {
       ++filt_count_;
       ++g_compared_samples;
     }
-    if (dut_->dbg_bank_valid) {
+    if (dut_->dbg_bank_valid) {  // one beat per code: CODES beats make a decimated output
       if (bank_expect_.empty()) return ::testing::AssertionFailure() << "bank: unexpected output";
       const BankTap& e = bank_expect_.front();
       const auto& l = design().layout;
       const auto& cc = design().config.correlator;
+      const int j = bank_beat_;
       std::ostringstream where;
-      where << " at decimated output " << bank_count_ << " (sample " << e.index << ")";
+      where << " at decimated output " << bank_count_ << " (sample " << e.index << "), beat " << j;
       const int cw = cc.chip_bits, kw = cc.corr_bits, qw = l.weighted_bits;
+      if (static_cast<int>(dut_->dbg_code) != j || (dut_->dbg_last != 0) != (j == l.codes - 1)) {
+        return ::testing::AssertionFailure() << "first mismatch: beat framing: code " << int(dut_->dbg_code)
+                                             << " last " << int(dut_->dbg_last) << where.str();
+      }
       if (sign_extend(get_bits(dut_->dbg_chip_re, 0, cw), cw) != e.chip_re ||
           sign_extend(get_bits(dut_->dbg_chip_im, 0, cw), cw) != e.chip_im) {
         return ::testing::AssertionFailure() << "first mismatch: chip filter F" << where.str();
       }
-      for (int j = 0; j < l.codes; ++j) {
-        if (sign_extend(get_bits(dut_->dbg_corr_re, j * kw, kw), kw) != e.corr_re[j] ||
-            sign_extend(get_bits(dut_->dbg_corr_im, j * kw, kw), kw) != e.corr_im[j]) {
-          return ::testing::AssertionFailure() << "first mismatch: combiner C code " << j + 1 << where.str();
-        }
+      if (sign_extend(get_bits(dut_->dbg_corr_re, 0, kw), kw) != e.corr_re[j] ||
+          sign_extend(get_bits(dut_->dbg_corr_im, 0, kw), kw) != e.corr_im[j]) {
+        return ::testing::AssertionFailure() << "first mismatch: combiner C code " << j + 1 << where.str();
       }
-      for (int j = 0; j < l.codes; ++j) {
-        if (get_bits(dut_->dbg_weighted, j * qw, qw) != e.q[j]) {
-          return ::testing::AssertionFailure() << "first mismatch: weighted power Q code " << j + 1 << where.str();
-        }
+      if (get_bits(dut_->dbg_weighted, 0, qw) != e.q[j]) {
+        return ::testing::AssertionFailure() << "first mismatch: weighted power Q code " << j + 1 << where.str();
       }
       if (get_bits(dut_->dbg_energy, 0, l.energy_bits) != e.energy) {
         return ::testing::AssertionFailure() << "first mismatch: energy" << where.str();
@@ -206,8 +208,11 @@ class Bench {
       if (static_cast<std::int64_t>(get_bits(dut_->dbg_index, 0, 40)) != e.index) {
         return ::testing::AssertionFailure() << "first mismatch: sample index" << where.str();
       }
-      bank_expect_.pop_front();
-      ++bank_count_;
+      if (++bank_beat_ == l.codes) {
+        bank_beat_ = 0;
+        bank_expect_.pop_front();
+        ++bank_count_;
+      }
     }
     if (dut_->m_axis_tvalid && dut_->m_axis_tready) {
       if (event_expect_.empty()) return ::testing::AssertionFailure() << "event: unexpected (duplicated?)";
@@ -257,6 +262,7 @@ class Bench {
   std::deque<EventFixed> event_expect_;
   std::deque<std::int64_t> pending_;
   std::uint64_t in_count_ = 0, filt_count_ = 0, bank_count_ = 0, events_seen_ = 0, settle_ = 0;
+  int bank_beat_ = 0;  // j of the next bank beat within its group
 };
 
 // A transmit schedule as the paper runs it: code 1..eta, one every `period` samples, received

@@ -51,6 +51,7 @@ struct ReceiverConfig {
   static constexpr std::int64_t BANK_TAP_VALUES[20] = {3912, 5683, 6983, 9174, 11660, 14200, 18108, 21204, 25936, 30047, 32767, 32766, 29836, 22758, 15130, 8704, 2762, 782, 60, 0};
   static constexpr std::int64_t BANK_CODE_BITS[63] = {1, 1, 0, 0, 1, 0, 1, 0, 0, 1, 1, 1, 0, 1, 1, 1, 1, 1, 0, 0, 0, 1, 0, 1, 1, 1, 1, 1, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 1, 0, 1, 0, 0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 1, 1};
   static constexpr std::int64_t BANK_WEIGHTS[9] = {40466, 25976, 14211, 16488, 25829, 20553, 46946, 23492, 54974};
+  static constexpr std::int64_t BANK_CODE_W = 4;
   // peak_detector
   static constexpr std::int64_t DET_CODES = 9;
   static constexpr std::int64_t DET_WEIGHTED_W = 48;

@@ -6,7 +6,9 @@
 // Event word, LSB first: code (4 bits, 1-based), arrival (49 bits, signed sample index with 8 fraction bits), score (16 bits, rho^2), margin (16 bits).
 // Back-pressure on m_axis stalls the pipeline back to s_axis_tready: no event is lost.
 // The dbg_* ports are the stage taps the testbenches compare with the golden model;
-// each is valid on the cycle its *_valid strobe is high (a completed beat).
+// each is valid on the cycle its *_valid strobe is high (a completed beat). The bank
+// streams one beat per code: a decimated output is CODES beats, dbg_code = j (0-based)
+// with dbg_last on the last; energy, index and chip are the group's on every beat.
 `default_nettype none
 
 module receiver_top (
@@ -22,19 +24,23 @@ module receiver_top (
   output wire signed [15:0] dbg_filter_data,
   output wire [79:0] dbg_filter_sections,
   output wire dbg_bank_valid,
-  output wire [431:0] dbg_weighted,
+  output wire [47:0] dbg_weighted,
+  output wire [3:0] dbg_code,
+  output wire dbg_last,
   output wire [40:0] dbg_energy,
   output wire [39:0] dbg_index,
   output wire signed [19:0] dbg_chip_re,
   output wire signed [19:0] dbg_chip_im,
-  output wire [143:0] dbg_corr_re,
-  output wire [143:0] dbg_corr_im
+  output wire signed [15:0] dbg_corr_re,
+  output wire signed [15:0] dbg_corr_im
 );
 
   wire signed [15:0] filter_data;
   wire filter_valid, filter_ready;
   wire bank_valid, bank_ready;
-  wire [431:0] bank_weighted;
+  wire [47:0] bank_weighted;
+  wire [3:0] bank_code;
+  wire bank_last;
   wire [40:0] bank_energy;
   wire [39:0] bank_index;
   wire [3:0] event_code;
@@ -91,12 +97,14 @@ module receiver_top (
     .LO_SIN(400'he02bc256a86193ee8645804282458c309d61b4c4d0e2eff5100b2f1e4b3c629f73d07dbb7fbe79bb6c12579f3daa1fd50000),
     .TAP_VALUES(320'h0000003c030e0aca22003b1a58e6748c7ffe7fff755f655052d446bc37782d8c23d61b4716330f48),
     .CODE_BITS(63'h6a42d8c44fa3ee53),
-    .WEIGHTS(144'hd6be5bc4b762504964e54068378365789e12)
+    .WEIGHTS(144'hd6be5bc4b762504964e54068378365789e12),
+    .CODE_W(32'd4)
   ) u_bank (
     .clk(clk), .rst(rst),
     .s_data(filter_data), .s_valid(filter_valid), .s_ready(filter_ready),
     .m_valid(bank_valid), .m_ready(bank_ready),
-    .m_weighted(bank_weighted), .m_energy(bank_energy), .m_index(bank_index),
+    .m_weighted(bank_weighted), .m_code(bank_code), .m_last(bank_last),
+    .m_energy(bank_energy), .m_index(bank_index),
     .m_chip_re(dbg_chip_re), .m_chip_im(dbg_chip_im),
     .m_corr_re(dbg_corr_re), .m_corr_im(dbg_corr_im)
   );
@@ -117,7 +125,8 @@ module receiver_top (
   ) u_detector (
     .clk(clk), .rst(rst),
     .s_valid(bank_valid), .s_ready(bank_ready),
-    .s_weighted(bank_weighted), .s_energy(bank_energy), .s_index(bank_index),
+    .s_weighted(bank_weighted), .s_last(bank_last),
+    .s_energy(bank_energy), .s_index(bank_index),
     .m_valid(m_axis_tvalid), .m_ready(m_axis_tready),
     .m_code(event_code), .m_arrival(event_arrival),
     .m_score(event_score), .m_margin(event_margin)
@@ -128,6 +137,8 @@ module receiver_top (
   assign dbg_filter_data = filter_data;
   assign dbg_bank_valid = bank_valid & bank_ready;
   assign dbg_weighted = bank_weighted;
+  assign dbg_code = bank_code;
+  assign dbg_last = bank_last;
   assign dbg_energy = bank_energy;
   assign dbg_index = bank_index;
 

@@ -6,7 +6,9 @@
 // Event word, LSB first: code (4 bits, 1-based), arrival (49 bits, signed sample index with 8 fraction bits), score (16 bits, rho^2), margin (16 bits).
 // Back-pressure on m_axis stalls the pipeline back to s_axis_tready: no event is lost.
 // The dbg_* ports are the stage taps the testbenches compare with the golden model;
-// each is valid on the cycle its *_valid strobe is high (a completed beat).
+// each is valid on the cycle its *_valid strobe is high (a completed beat). The bank
+// streams one beat per code: a decimated output is CODES beats, dbg_code = j (0-based)
+// with dbg_last on the last; energy, index and chip are the group's on every beat.
 `default_nettype none
 
 module receiver_top (
@@ -22,19 +24,23 @@ module receiver_top (
   output wire signed [15:0] dbg_filter_data,
   output wire [79:0] dbg_filter_sections,
   output wire dbg_bank_valid,
-  output wire [503:0] dbg_weighted,
+  output wire [55:0] dbg_weighted,
+  output wire [3:0] dbg_code,
+  output wire dbg_last,
   output wire [41:0] dbg_energy,
   output wire [39:0] dbg_index,
   output wire signed [23:0] dbg_chip_re,
   output wire signed [23:0] dbg_chip_im,
-  output wire [179:0] dbg_corr_re,
-  output wire [179:0] dbg_corr_im
+  output wire signed [19:0] dbg_corr_re,
+  output wire signed [19:0] dbg_corr_im
 );
 
   wire signed [15:0] filter_data;
   wire filter_valid, filter_ready;
   wire bank_valid, bank_ready;
-  wire [503:0] bank_weighted;
+  wire [55:0] bank_weighted;
+  wire [3:0] bank_code;
+  wire bank_last;
   wire [41:0] bank_energy;
   wire [39:0] bank_index;
   wire [3:0] event_code;
@@ -91,12 +97,14 @@ module receiver_top (
     .LO_SIN(400'he02bc256a86193ee8645804282458c309d61b4c4d0e2eff5100b2f1e4b3c629f73d07dbb7fbe79bb6c12579f3daa1fd50000),
     .TAP_VALUES(9432'h00000000000000000000000000000000000000000000000000000100004000100004000100003fffffffffffff0000000030001c000d0004800160005c001600044000d000340014000940043001a80096002fc00dd003ac00ea0038000da0039c0118005d401ff00aa8035f01008047c012f804cd0130404c2013f4059b01ac8083c028500c00036ec0f0903f38101404044101c0426411dd05050173306bc81ede089c8253a09be427ba09f5427e00a2182a5e0b70032a70e2b03f1e114a44a0d135584efa13d984f6613fd451fa1583c5c50191486d351d7747d3820a0c858521a7486b021bd088a023270934627148a6dc2c680bb4530ae4c777326a0ca1f32890cb2033924d44c3748ce8153cf8cff15421690edb449c513b044f0514184585d1ab7489192c584df814377536c9557c5697d5c9a574495d1657829610e59ad96eeb5e3b5838f635f1959166c899e2467ca59f3567df9a118692d9aa7c6c7fdba6370a69c9a673b65d1fd74d65d39974e75d43b7583dd9537775de31c7a1cded307c35df3337d181f4ba7d2e9f4d97d5b5f6977e109fa337f071fdbb7fb99ff977ff9dfffd7fffdffff7ffddffcc7fd65fe817f4f9fbab7e7e9f86f7dd19f69b7d991f6667d919f59c7d051f1877b825e9ee796c9e1e277bc1dd1877129dc2a77099db98767c1d6de7499dcce671bf1c1656f331b99c6df9db75c6dd71b7206d7b5b33d6bba9a93168aad9c2165981920263d298e126375d8dd3634dd8b5761f5d82c45f23175e65be916a7d59b9164e9590e5642e5900562f1581ed5c7555c6150f152b014543504393e634f4913cdb4f3693c634eb6937ea4ce592e3b4a1d922fd479d11b3f465d118cc462f9189e45f1915c3449b10def4230903853fb74fb473e3f4f7e93dea4f7a83dd18f5ff3ce1cefe13ad74e67e3877cde0936d54d9d236514d93a36478d86535ab8d3d634018cba231cccc343300f0be4f2f59cbd312f4c0bcdd2ef24b9b52da94b2db2bb14aae629ebca56a29090a3ac28e88a38c28be0a19527d1c9c2e2626894fb247088f45236b08ce9232e08cb8231f08baa2284087ae212dc81811f9c87be41e84c79091e29078991e23078231dc7875661cc44705b1b6606b201a4d067f519d64673019cc46708199cc654818e20615617bc85ca916af8595e162505845160f0583415fa4572c157a45431148c050251393c4ce112fcc4b7e12d7c4b6012d084ad3127d848a911c1c453f10e2c421d1045c408010114403f100e040000fdc83e800f4d43bb40e8ac38ca0dedc37040dab036940da54367f0d8b035860d23433530c7f030b40be802ed90b9982e380b8cc2e2f0b8182d9e0b3b02bf80ab6429b40a2ac27dc09d50271009bf426fe09bbc26b5098fc258a0929423ab08ae421ec0856021010837820d90835c20bc081d01ff607d201e7a0769c1ce70713c1beb06ee41baa06ea81ba106de81b2706aa01a060655018a70605017a905da8175105d34174c05ce4170705ab8163305688150b05208141604f3813aa04e7c13a004e64137d04d0812e8049d011f5045e411100430c10960421010810420010730413c100f03edc0f4e03b840e7f038c00dfc037880dda037680dd6037080d980355c0d04032a00c4e02d280a8a),
     .CODE_BITS(63'h6a42d8c44fa3ee53),
-    .WEIGHTS(144'h8e643c17781f374b433e28d924bd45756bc1)
+    .WEIGHTS(144'h8e643c17781f374b433e28d924bd45756bc1),
+    .CODE_W(32'd4)
   ) u_bank (
     .clk(clk), .rst(rst),
     .s_data(filter_data), .s_valid(filter_valid), .s_ready(filter_ready),
     .m_valid(bank_valid), .m_ready(bank_ready),
-    .m_weighted(bank_weighted), .m_energy(bank_energy), .m_index(bank_index),
+    .m_weighted(bank_weighted), .m_code(bank_code), .m_last(bank_last),
+    .m_energy(bank_energy), .m_index(bank_index),
     .m_chip_re(dbg_chip_re), .m_chip_im(dbg_chip_im),
     .m_corr_re(dbg_corr_re), .m_corr_im(dbg_corr_im)
   );
@@ -117,7 +125,8 @@ module receiver_top (
   ) u_detector (
     .clk(clk), .rst(rst),
     .s_valid(bank_valid), .s_ready(bank_ready),
-    .s_weighted(bank_weighted), .s_energy(bank_energy), .s_index(bank_index),
+    .s_weighted(bank_weighted), .s_last(bank_last),
+    .s_energy(bank_energy), .s_index(bank_index),
     .m_valid(m_axis_tvalid), .m_ready(m_axis_tready),
     .m_code(event_code), .m_arrival(event_arrival),
     .m_score(event_score), .m_margin(event_margin)
@@ -128,6 +137,8 @@ module receiver_top (
   assign dbg_filter_data = filter_data;
   assign dbg_bank_valid = bank_valid & bank_ready;
   assign dbg_weighted = bank_weighted;
+  assign dbg_code = bank_code;
+  assign dbg_last = bank_last;
   assign dbg_energy = bank_energy;
   assign dbg_index = bank_index;
 
