@@ -32,10 +32,12 @@
 //            distance 0), bit 1 ToF or distance saturated.
 //
 // Timing:    sequential (no DSP): up to CODES-1 cycles to step back to code j's
-//            burst, 1-2 cycles for the ToF, TOF_W cycles of shift-add (one C_W+1-bit adder)
-//            multiply, then the result waits on m_ready. s_ready is high only
-//            when idle: under 50 cycles per event, events come every PERIOD_T
-//            samples.
+//            burst, 1-2 cycles for the ToF (one more per cycle stepped back),
+//            TOF_W cycles of shift-add (one C_W+1-bit adder) multiply with the
+//            rounding term as its start value, 1 cycle to saturate the distance,
+//            then the result waits on m_ready. s_ready is high only when idle:
+//            under 50 cycles per event, events come every PERIOD_T samples.
+//            Needs FRAC_W + C_FRAC < TOF_W and FRAC_W + C_FRAC <= C_W.
 //
 ////////////////////////////////////////////////////////////////////////////////
 `default_nettype none
@@ -73,21 +75,24 @@ module tof_distance #(
   input  wire signed [TIME_W+FRAC_W:0] s_arrival,
   input  wire [SCORE_W-1:0] s_score, s_margin,
   // measurements
-  output reg  m_valid,
+  output wire m_valid,
   input  wire m_ready,
   output reg  [CODE_W-1:0] m_code,
-  output reg  [1:0] m_flags,
-  output reg  [TOF_W-1:0] m_tof,
-  output reg  [DIST_W-1:0] m_distance,
+  output wire [1:0] m_flags,
+  output wire [TOF_W-1:0] m_tof,
+  output wire [DIST_W-1:0] m_distance,
   output reg  [SCORE_W-1:0] m_score, m_margin
 );
-  localparam integer AW = TIME_W + FRAC_W + 3;        // signed working width
-  localparam integer TW = TIME_W + 2;                 // signed burst times
+  localparam integer ARR_W = TIME_W + FRAC_W + 1;     // s_arrival
+  localparam integer AW = (ARR_W > OFF_W ? ARR_W : OFF_W) + 1;  // A = arrival - offset, signed
+  localparam integer DW = AW + 1;                     // A - t 2^FRAC_W, signed (t < 2^TIME_W)
+  localparam integer TW = TIME_W + 2;                 // signed burst times, t - CYCLE
   localparam integer KW = CODE_W + 1;
-  localparam integer PW = TOF_W + C_W;
   localparam integer SH = FRAC_W + C_FRAC;
-  localparam integer MCW = $clog2(TOF_W + 1);
-  localparam [2:0] IDLE = 0, BACK = 1, TOF = 2, MUL = 3, OUT = 4;
+  localparam integer LO_W = TOF_W - SH;               // product bits below hi that reach the distance
+  localparam integer CNT_W = ($clog2(TOF_W) > KW + 1 ? $clog2(TOF_W) : KW + 1);
+  localparam integer CYCLE = CODES * PERIOD_T;
+  localparam [2:0] IDLE = 0, BACK = 1, TOF = 2, MUL = 3, CLAMP = 4, OUT = 5;
 
   reg [2:0] state;
   reg have_burst;
@@ -96,17 +101,26 @@ module tof_distance #(
 
   reg signed [AW-1:0] a;      // A = arrival - offset
   reg signed [TW-1:0] t;      // candidate burst start
-  reg [KW:0] k;
+  reg [CNT_W-1:0] cnt;        // BACK: periods left to step back; MUL: steps done
   reg no_tx, sat;
-  // Product ToF * C by right-shifting shift-add: {hi, mplier} holds the partial product;
-  // each step adds C to hi when the multiplier's low bit is 1 and shifts the pair right,
-  // so after TOF_W steps {hi, mplier} = ToF * C (PW bits) with only a C_W+1-bit adder.
+  // Product ToF * C + 2^(SH-1) (the rounding term) by right-shifting shift-add: each step adds C
+  // to hi when the multiplier's low bit is 1 and shifts hi right; the bit shifted out is the next
+  // product bit (only the last LO_W of them reach the distance). hi starts at 2^(SH-1), which
+  // adds 2^(SH-1) to the product. The multiplier rotates, so after TOF_W steps it is the ToF again.
   reg [TOF_W-1:0] mplier;
   reg [C_W-1:0] hi;      // < 2^C_W after every step: (hi + C) / 2 < 2^C_W
+  reg [LO_W-1:0] lo;
   reg [C_W-1:0] c_used;
-  reg [MCW-1:0] mcount;
 
+  // the event is taken when idle (the consumer of the measurements may hold m_ready low for a
+  // whole UART frame; the receiver must not wait that long), its fields are copied
   assign s_ready = state == IDLE;
+  assign m_valid = state == OUT;
+  assign m_tof = mplier;
+  wire [C_W+LO_W-1:0] dist_full = {hi, lo};  // (ToF * C + 2^(SH-1)) >> SH
+  wire dist_over = |dist_full[C_W+LO_W-1:DIST_W];
+  assign m_distance = dist_full[DIST_W-1:0];  // saturated in CLAMP
+  assign m_flags = {sat, no_tx};
 
   // offset of the event's code (a small ROM)
   wire [CODES*OFF_W-1:0] offsets = OFFSETS;
@@ -115,14 +129,10 @@ module tof_distance #(
   wire signed [KW:0] diff = $signed({2'b00, last_code}) - $signed({2'b00, s_code});
   wire signed [KW:0] k0 = diff < 0 ? diff + CODES : diff;
 
-  wire signed [AW-1:0] t_scaled = $signed(t) <<< FRAC_W;
-  wire signed [AW-1:0] tof_w = a - t_scaled;
-  localparam integer CYCLE = CODES * PERIOD_T;
-  // (P + 2^(SH-1)) >> SH == (P >> SH) + P[SH-1]: round half up as an increment.
-  wire [PW-1:0] prod = {hi, mplier};
+  // one subtractor steps t back (a period in BACK, a cycle in TOF); its sign in TOF is t < CYCLE
+  wire signed [TW-1:0] t_step = t - (state == BACK ? PERIOD_T : CYCLE);
+  wire signed [DW-1:0] tof_w = a - ($signed(t) <<< FRAC_W);
   wire [C_W:0] hsum = {1'b0, hi} + (mplier[0] ? {1'b0, c_used} : {(C_W+1){1'b0}});
-  wire [PW:0] dist_full = {1'b0, prod[PW-1:SH]} + prod[SH-1];
-  wire dist_over = |dist_full[PW:DIST_W];
 
   always @(posedge clk) begin
     if (rst) begin
@@ -131,10 +141,6 @@ module tof_distance #(
       last_time <= 0;
       last_code <= 0;
       c_current <= C_INIT;
-      m_valid <= 1'b0;
-      m_code <= 0; m_flags <= 0; m_tof <= 0; m_distance <= 0; m_score <= 0; m_margin <= 0;
-      a <= 0; t <= 0; k <= 0; no_tx <= 0; sat <= 0; mplier <= 0; hi <= 0;
-      c_used <= 0; mcount <= 0;
     end else begin
       if (burst_valid) begin
         have_burst <= 1'b1;
@@ -143,62 +149,62 @@ module tof_distance #(
       end
       if (c_wr) c_current <= c_value;
       case (state)
-        IDLE: if (s_valid) begin
-          m_code <= s_code;
-          m_score <= s_score;
-          m_margin <= s_margin;
-          a <= $signed(s_arrival) - off;
-          t <= $signed({2'b00, last_time});
-          k <= k0;
-          no_tx <= !have_burst;
-          sat <= 1'b0;
-          c_used <= c_current;
-          state <= BACK;
-        end
-        BACK: if (k != 0) begin
-          t <= t - PERIOD_T;
-          k <= k - 1'b1;
-        end else begin
-          state <= TOF;
-        end
-        TOF: begin
-          if (no_tx) begin
-            mplier <= 0;
-            state <= MUL;
-          end else if (t < 0) begin
-            no_tx <= 1'b1;  // code j's burst would precede the first one: never sent
-          end else if (tof_w < 0) begin
-            if (t < CYCLE) no_tx <= 1'b1;
-            else t <= t - CYCLE;
-          end else begin
-            if (|tof_w[AW-1:TOF_W]) begin
-              mplier <= {TOF_W{1'b1}};
-              sat <= 1'b1;
-            end else begin
-              mplier <= tof_w[TOF_W-1:0];
-            end
-            state <= MUL;
-          end
-          hi <= 0;
-          mcount <= 0;
-        end
-        MUL: begin
-          {hi, mplier} <= {hsum, mplier[TOF_W-1:1]};  // (hi + C [lsb]) : mplier, shifted right
-          if (mcount == TOF_W - 1) state <= OUT;
-          mcount <= mcount + 1'b1;
-          if (mcount == 0) m_tof <= mplier;
-        end
-        OUT: if (!m_valid) begin
-          m_valid <= 1'b1;
-          m_flags <= {sat || dist_over, no_tx};
-          m_distance <= dist_over ? {DIST_W{1'b1}} : dist_full[DIST_W-1:0];
-        end else if (m_ready) begin
-          m_valid <= 1'b0;
-          state <= IDLE;
-        end
+        IDLE: if (s_valid) state <= BACK;
+        BACK: if (cnt == 0) state <= TOF;
+        TOF: if (no_tx || (!t[TW-1] && !tof_w[DW-1])) state <= MUL;
+        MUL: if (cnt == TOF_W - 1) state <= CLAMP;
+        CLAMP: state <= OUT;
+        OUT: if (m_ready) state <= IDLE;
         default: state <= IDLE;
       endcase
     end
+  end
+
+  // datapath (no reset: every field is loaded before it is read)
+  always @(posedge clk) begin
+    case (state)
+      IDLE: begin
+        a <= $signed(s_arrival) - off;
+        t <= $signed({2'b00, last_time});
+        cnt <= k0;
+        no_tx <= !have_burst;
+        c_used <= c_current;
+        m_code <= s_code;
+        m_score <= s_score;
+        m_margin <= s_margin;
+      end
+      BACK: if (cnt != 0) begin
+        t <= t_step;
+        cnt <= cnt - 1'b1;
+      end
+      TOF: begin
+        if (no_tx) begin
+          mplier <= 0;
+          sat <= 1'b0;
+        end else if (t[TW-1]) begin
+          no_tx <= 1'b1;  // code j's burst would precede the first one: never sent
+        end else if (tof_w[DW-1]) begin
+          if (t_step[TW-1]) no_tx <= 1'b1;
+          else t <= t_step;
+        end else begin
+          sat <= |tof_w[DW-1:TOF_W];
+          mplier <= |tof_w[DW-1:TOF_W] ? {TOF_W{1'b1}} : tof_w[TOF_W-1:0];
+        end
+        hi <= 1 << (SH - 1);
+        cnt <= 0;
+      end
+      MUL: begin
+        hi <= hsum[C_W:1];
+        lo <= {hsum[0], lo[LO_W-1:1]};
+        mplier <= {mplier[0], mplier[TOF_W-1:1]};
+        cnt <= cnt + 1'b1;
+      end
+      CLAMP: if (dist_over) begin
+        {hi, lo} <= {(C_W+LO_W){1'b1}};
+        sat <= 1'b1;
+      end
+      default: ;
+    endcase
   end
 endmodule
 
