@@ -123,15 +123,17 @@ module peak_detector #(
   localparam [KW-1:0] NB_K = NB_I[KW-1:0];
   localparam [IW-1:0] NA_LAST = NA_I[IW-1:0] - 1'b1;
 
+  localparam integer AB    = (JB > 2) ? JB : 2;                   // memory index bits
   localparam [3:0] S_IDLE = 4'd0, S_MAC = 4'd2, S_DECIDE = 4'd3,
-                   S_P0 = 4'd4, S_P1 = 4'd5, S_DIV = 4'd6, S_NEXT = 4'd7, S_OUT = 4'd8;
+                   S_P0 = 4'd4, S_P1 = 4'd5, S_DIV = 4'd6, S_NEXT = 4'd7, S_OUT = 4'd8,
+                   S_CP = 4'd9, S_EA = 4'd10, S_EB = 4'd11;
   reg [3:0] state;
 
   // ---------------------------------------------------------------- input beats and scan
   reg [NW-1:0]       nrm;            // norm = E >> ENERGY_SHIFT
   reg [TIME_W-1:0]   n_r;
   reg [JB-1:0]       j;
-  reg [JB-1:0]       best;
+  reg [JB-1:0]       best, sidx;    // sidx: index of second
   reg [QW-1:0]       best_q, second;
   reg                par, prev_ok;   // memory half of this group; a previous group exists
   wire [QW-1:0] head = s_weighted;
@@ -139,24 +141,70 @@ module peak_detector #(
   wire first = (j == {JB{1'b0}});
   wire gt_best = head > best_q, gt_second = head > second;
 
-  // previous / current beat's Q vectors (ping-pong halves of one memory -> EBR)
-  reg [QW-1:0] pmem [0:(2 << JB)-1];
-  reg [QW-1:0] p_rd;
-  always @(posedge clk) begin
-    if (take) pmem[{par, j}] <= head;
-    if (state == S_MAC) p_rd <= pmem[{~par, best}];
-  end
-
   // ---------------------------------------------------------------- candidate
   reg                c_valid, c_has_next;
   reg [TIME_W-1:0]   c_n;
   reg [JB-1:0]       c_code;
-  reg [QW-1:0]       c_qp, c_q, c_qn, c_q2;
   reg [NW-1:0]       c_norm1;
+  reg                cp_kind, qp_zero;   // copy program: 1 capture (Qp, Q, Q2), 0 Q_next
+  reg [1:0]          cp;
+
+  // One memory (EBR): this / previous group's Q vectors (ping-pong halves 0x, by group
+  // parity) and the candidate's words Q_prev, Q, Q2, Q_next (region 10), copied there from
+  // the halves through the read register after the tests (no candidate word in DFFs).
+  reg [QW-1:0] pmem [0:(4 << AB)-1];
+  reg [QW-1:0] p_rd;
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [AB+JB-1:0] best_x = {{AB{1'b0}}, best};
+  wire [AB+JB-1:0] sidx_x = {{AB{1'b0}}, sidx};
+  wire [AB+JB-1:0] cc_x   = {{AB{1'b0}}, c_code};
+  wire [AB+JB-1:0] j_x    = {{AB{1'b0}}, j};
+  /* verilator lint_on UNUSEDSIGNAL */
+  localparam [AB+1:0] C_QP = {2'b10, {(AB-2){1'b0}}, 2'd0}, C_Q  = {2'b10, {(AB-2){1'b0}}, 2'd1},
+                      C_Q2 = {2'b10, {(AB-2){1'b0}}, 2'd2}, C_QN = {2'b10, {(AB-2){1'b0}}, 2'd3};
+  // par was toggled in S_DECIDE: in S_CP the group just scanned is half ~par, its
+  // predecessor half par
+  reg [AB+1:0] raddr;
+  always @* begin
+    raddr = C_Q;                                  // S_MAC (rho^2 operand), S_P0, S_P1
+    case (state)
+      S_CP: if (!cp_kind)   raddr = {1'b0, ~par, cc_x[AB-1:0]};
+            else if (cp == 2'd0) raddr = {1'b0, par, best_x[AB-1:0]};
+            else if (cp == 2'd1) raddr = {1'b0, ~par, best_x[AB-1:0]};
+            else            raddr = {1'b0, ~par, sidx_x[AB-1:0]};
+      S_EA: raddr = C_QP;
+      S_EB: raddr = C_QN;
+      S_DIV, S_NEXT: raddr = C_Q2;
+      default: ;
+    endcase
+  end
+  wire re = (state == S_MAC) || (state == S_CP) || (state == S_EA) || (state == S_EB) ||
+            (state == S_P0) || (dsel != 2'd0 && (state == S_DIV || state == S_NEXT));
+  wire cp_we = (state == S_CP) && cp != 2'd0;
+  wire [AB+1:0] waddr = take ? {1'b0, par, j_x[AB-1:0]}
+                             : {2'b10, {(AB-2){1'b0}}, cp_kind ? cp - 1'b1 : 2'd3};
+  wire [QW-1:0] wdata = take ? head : (p_rd & {QW{!(cp_kind && cp == 2'd1 && qp_zero)}});
+  always @(posedge clk) begin
+    if (take || cp_we) pmem[waddr] <= wdata;
+    if (re) p_rd <= pmem[raddr];
+  end
+  wire cp_end = cp_kind ? (cp == 2'd3) : (cp == 2'd1);
 
   wire [NW-1:0] norm1 = {nrm[NW-1:1], nrm[0] | (nrm == {NW{1'b0}})};
-  wire [ENERGY_W:0] nrm_x = {{(ENERGY_W-NW+1){1'b0}}, nrm};
-  wire min_ok = nrm_x >= {1'b0, MIN_NORM};
+  // norm >= MIN_NORM compared only on MIN_NORM's significant bits (no wide constant compare)
+  function integer bitlen;
+    input [ENERGY_W-1:0] v;
+    integer b;
+    begin
+      bitlen = 0;
+      for (b = 0; b < ENERGY_W; b = b + 1)
+        if (v[b]) bitlen = b + 1;
+    end
+  endfunction
+  localparam integer MB0 = bitlen(MIN_NORM);
+  localparam integer MB  = (MB0 < 1) ? 1 : (MB0 > NW) ? NW : MB0;
+  localparam [MB-1:0] MIN_LO = MIN_NORM[MB-1:0];
+  wire min_ok = (MB0 <= NW) && (((nrm >> MB) != {NW{1'b0}}) || nrm[MB-1:0] >= MIN_LO);
 
   // ---------------------------------------------------------------- MAC: D = A1 B1 - A2 B2
   reg            m_run, m_mode;      // mode 0: gate, 1: rho^2 comparison
@@ -174,7 +222,7 @@ module peak_detector #(
   // digit vectors, one spare top bit (never selected) so that no replication is zero-width
   /* verilator lint_off UNUSEDSIGNAL */
   wire [NA*16:0] a1_v = {{(NA*16-QW+1){1'b0}}, best_q};
-  wire [NA*16:0] a2_v = m_mode ? {{(NA*16-QW+1){1'b0}}, c_q}
+  wire [NA*16:0] a2_v = m_mode ? {{(NA*16-QW+1){1'b0}}, p_rd}
                                : {{(NA*16-SCORE_W+1){1'b0}}, THRESHOLD};
   wire [NB*16:0] b1_v = m_mode ? {{(NB*16-NW+1){1'b0}}, c_norm1} : {{NB*16{1'b0}}, 1'b1};
   wire [NB*16:0] b2_v = {{(NB*16-NW+1){1'b0}}, norm1};
@@ -221,22 +269,23 @@ module peak_detector #(
   /* verilator lint_on UNUSEDSIGNAL */
   wire [FR_W-1:0] fq = fq_x[FR_W-1:0] & {{2{1'b0}}, {FRAC_W{1'b1}}};
   wire den_pos = !dv_d[W-1] && (dv_d != {W{1'b0}});
-  wire [QW:0] q_hi  = {1'b0, c_q}  >> (SCORE_W + 1);
-  wire [QW:0] q2_hi = {1'b0, c_q2} >> (SCORE_W + 1);
+  // the dividend (Q in S_NEXT dsel 0, Q2 in S_NEXT dsel 1) is in the memory read register
+  wire [QW:0] q_hi  = {1'b0, p_rd}  >> (SCORE_W + 1);
   // Q[SCORE_W:0] at the top of the KM-bit dividend register
   /* verilator lint_off UNUSEDSIGNAL */
-  wire [KM+SCORE_W:0] q_lo_x  = {c_q[SCORE_W:0],  {KM{1'b0}}};
-  wire [KM+SCORE_W:0] q2_lo_x = {c_q2[SCORE_W:0], {KM{1'b0}}};
+  wire [KM+SCORE_W:0] q_lo_x  = {p_rd[SCORE_W:0],  {KM{1'b0}}};
   /* verilator lint_on UNUSEDSIGNAL */
   wire [KM-1:0] q_lo  = q_lo_x[KM+SCORE_W -: KM];
-  wire [KM-1:0] q2_lo = q2_lo_x[KM+SCORE_W -: KM];
 
   /* verilator lint_off UNUSEDSIGNAL */
   wire [CODE_W+JB-1:0] code_x = {{CODE_W{1'b0}}, c_code};
   /* verilator lint_on UNUSEDSIGNAL */
-  wire hn_now = c_valid && !c_has_next;   // candidate takes Q_next this beat (scan)
+  // a candidate without Q_next takes it from this group (copied in S_CP), so it can emit now
   wire [TIME_W-1:0] since = n_r - c_n;
-  wire emit = c_valid && (c_has_next || hn_now) && since >= HOLD_T;
+  localparam integer HB0 = $clog2(HOLDOFF + 1);            // significant bits of HOLDOFF
+  localparam integer HB  = (HB0 < 1) ? 1 : HB0;
+  localparam [HB-1:0] HOLD_LO = HOLD_T[HB-1:0];
+  wire emit = c_valid && (((since >> HB) != {TIME_W{1'b0}}) || since[HB-1:0] >= HOLD_LO);
 
   // output: held in S_OUT (the registers it is computed from do not change there)
   localparam integer DECIM_I = DECIM;
@@ -299,17 +348,25 @@ module peak_detector #(
           prev_ok <= 1'b1;
           state <= S_IDLE;
           // gate_r && m_mode: the rho^2 test ran (a candidate exists); its result is d_gt0.
+          cp_kind <= 1'b1;
           if (gate_r && (!c_valid || d_gt0)) begin
             c_valid <= 1'b1;
             c_has_next <= 1'b0;
+            state <= S_CP;
           end else if (emit) begin
             c_valid <= 1'b0;
             c_has_next <= 1'b0;
-            state <= S_P0;
+            cp_kind <= 1'b0;
+            state <= c_has_next ? S_EA : S_CP;
           end else begin
             c_has_next <= c_valid;
+            cp_kind <= 1'b0;
+            if (c_valid && !c_has_next) state <= S_CP;
           end
         end
+        S_CP: if (cp_end) state <= (cp_kind || c_valid) ? S_IDLE : S_EA;
+        S_EA: state <= S_EB;
+        S_EB: state <= S_P0;
         S_P0: state <= S_P1;
         S_P1: state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
         S_DIV: if (dv_cnt + 1'b1 == dv_k) state <= S_NEXT;
@@ -352,10 +409,10 @@ module peak_detector #(
         best_q <= head;
         best <= j;
       end
+      // sidx is only read when a candidate is captured (second meaningful: CODES > 1)
       if (first) second <= {QW{1'b0}};
-      else if (gt_best) second <= best_q;
-      else if (gt_second) second <= head;
-      if (hn_now && j == c_code) c_qn <= head;
+      else if (gt_best) begin second <= best_q; sidx <= best; end
+      else if (gt_second) begin second <= head; sidx <= j; end
       nrm <= s_energy[ENERGY_W-1 -: NW];
       n_r <= s_index;
     end
@@ -363,22 +420,24 @@ module peak_detector #(
     if (state == S_DECIDE && gate_r && (!c_valid || d_gt0)) begin
       c_n <= n_r;
       c_code <= best;
-      c_qp <= prev_ok ? p_rd : {QW{1'b0}};
-      c_q <= best_q;
-      c_q2 <= second;
       c_norm1 <= norm1;
     end
+    if (state == S_DECIDE) begin
+      qp_zero <= !prev_ok;
+      cp <= 2'd0;
+    end else if (state == S_CP) cp <= cp + 1'b1;
     case (state)
-      // dQ into dv_r, Q_prev + Q_next into dv_d
+      S_EB: dv_d <= {{(W-QW){1'b0}}, p_rd};     // Q_prev
+      // dQ into dv_r, Q_prev + Q_next into dv_d (p_rd = Q_next)
       S_P0: begin
-        dv_r <= {{(W-QW){1'b0}}, c_qn} - {{(W-QW){1'b0}}, c_qp};
-        dv_d <= {{(W-QW){1'b0}}, c_qn} + {{(W-QW){1'b0}}, c_qp};
+        dv_r <= {{(W-QW){1'b0}}, p_rd} - dv_d;
+        dv_d <= {{(W-QW){1'b0}}, p_rd} + dv_d;
       end
       // |dQ| (restoring remainder), den = 4Q - 2(Q_prev + Q_next)
       S_P1: begin
         ev_neg <= dv_r[W-1];
         dv_r <= dv_r[W-1] ? -dv_r : dv_r;
-        dv_d <= ({{(W-QW){1'b0}}, c_q} << 2) - (dv_d << 1);
+        dv_d <= ({{(W-QW){1'b0}}, p_rd} << 2) - (dv_d << 1);
         dv_q <= {KM{1'b0}};
         dv_cnt <= {CW{1'b0}};
         dsel <= 2'd0;
@@ -402,8 +461,8 @@ module peak_detector #(
         end else if (dsel == 2'd1) begin
           sc1 <= score_now;
           dsel <= 2'd2;
-          dv_r <= {{(W-QW-1){1'b0}}, q2_hi};
-          dv_q <= q2_lo;
+          dv_r <= {{(W-QW-1){1'b0}}, q_hi};
+          dv_q <= q_lo;
         end
       end
       default: ;
