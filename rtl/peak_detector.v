@@ -126,20 +126,27 @@ module peak_detector #(
   localparam integer AB    = (JB > 2) ? JB : 2;                   // memory index bits
   localparam [3:0] S_IDLE = 4'd0, S_MAC = 4'd2, S_DECIDE = 4'd3,
                    S_P0 = 4'd4, S_P1 = 4'd5, S_DIV = 4'd6, S_NEXT = 4'd7, S_OUT = 4'd8,
-                   S_CP = 4'd9, S_EA = 4'd10, S_EB = 4'd11;
+                   S_CP = 4'd9, S_EA = 4'd10, S_EB = 4'd11, S_P2 = 4'd12, S_R2 = 4'd13;
   reg [3:0] state;
 
   // ---------------------------------------------------------------- input beats and scan
   reg [NW-1:0]       nrm;            // norm = E >> ENERGY_SHIFT
   reg [TIME_W-1:0]   n_r;
   reg [JB-1:0]       j;
-  reg [JB-1:0]       best, sidx;    // sidx: index of second
-  reg [QW-1:0]       best_q, second;
+  reg [JB-1:0]       best, sidx;    // sidx: index of second (found by a re-read at capture)
+  reg [QW-1:0]       best_q;         // running max: of the beats (scan), then of j != best
+  reg                r_v, r_end, s_found;
+  reg [JB-1:0]       r_j;
   reg                par, prev_ok;   // memory half of this group; a previous group exists
   wire [QW-1:0] head = s_weighted;
   wire take = s_valid && state == S_IDLE;   // a beat is accepted
   wire first = (j == {JB{1'b0}});
-  wire gt_best = head > best_q, gt_second = head > second;
+  localparam integer JLAST_I = CODES - 1;
+  localparam [JB-1:0] JLAST = JLAST_I[JB-1:0];
+  reg  [QW-1:0] p_rd;
+  // one comparator: the beat (scan) or the re-read word (S_R2) against best_q
+  wire [QW-1:0] cmp_in = (state == S_R2) ? p_rd : head;
+  wire gt_best = cmp_in > best_q;
 
   // ---------------------------------------------------------------- candidate
   reg                c_valid, c_has_next;
@@ -153,7 +160,6 @@ module peak_detector #(
   // parity) and the candidate's words Q_prev, Q, Q2, Q_next (region 10), copied there from
   // the halves through the read register after the tests (no candidate word in DFFs).
   reg [QW-1:0] pmem [0:(4 << AB)-1];
-  reg [QW-1:0] p_rd;
   /* verilator lint_off UNUSEDSIGNAL */
   wire [AB+JB-1:0] best_x = {{AB{1'b0}}, best};
   wire [AB+JB-1:0] sidx_x = {{AB{1'b0}}, sidx};
@@ -166,24 +172,25 @@ module peak_detector #(
   // predecessor half par
   reg [AB+1:0] raddr;
   always @* begin
-    raddr = C_Q;                                  // S_MAC (rho^2 operand), S_P0, S_P1
+    raddr = C_Q;                                  // S_MAC (rho^2 operand), S_P1, S_P2
     case (state)
       S_CP: if (!cp_kind)   raddr = {1'b0, ~par, cc_x[AB-1:0]};
             else if (cp == 2'd0) raddr = {1'b0, par, best_x[AB-1:0]};
             else if (cp == 2'd1) raddr = {1'b0, ~par, best_x[AB-1:0]};
             else            raddr = {1'b0, ~par, sidx_x[AB-1:0]};
-      S_EA: raddr = C_QP;
-      S_EB: raddr = C_QN;
+      S_R2: raddr = {1'b0, ~par, j_x[AB-1:0]};
+      S_EA, S_P0: raddr = C_QN;
+      S_EB: raddr = C_QP;
       S_DIV, S_NEXT: raddr = C_Q2;
       default: ;
     endcase
   end
-  wire re = (state == S_MAC) || (state == S_CP) || (state == S_EA) || (state == S_EB) ||
-            (state == S_P0) || (dsel != 2'd0 && (state == S_DIV || state == S_NEXT));
+  wire re = (state == S_MAC) || (state == S_R2) || (state == S_CP) || (state == S_EA) || (state == S_EB) ||
+            (state == S_P0) || (state == S_P1) || (dsel != 2'd0 && (state == S_DIV || state == S_NEXT));
   wire cp_we = (state == S_CP) && cp != 2'd0;
   wire [AB+1:0] waddr = take ? {1'b0, par, j_x[AB-1:0]}
                              : {2'b10, {(AB-2){1'b0}}, cp_kind ? cp - 1'b1 : 2'd3};
-  wire [QW-1:0] wdata = take ? head : (p_rd & {QW{!(cp_kind && cp == 2'd1 && qp_zero)}});
+  wire [QW-1:0] wdata = take ? head : (p_rd & {QW{!(cp_kind && ((cp == 2'd1 && qp_zero) || (cp == 2'd3 && !s_found)))}});
   always @(posedge clk) begin
     if (take || cp_we) pmem[waddr] <= wdata;
     if (re) p_rd <= pmem[raddr];
@@ -352,7 +359,7 @@ module peak_detector #(
           if (gate_r && (!c_valid || d_gt0)) begin
             c_valid <= 1'b1;
             c_has_next <= 1'b0;
-            state <= S_CP;
+            state <= S_R2;
           end else if (emit) begin
             c_valid <= 1'b0;
             c_has_next <= 1'b0;
@@ -364,11 +371,19 @@ module peak_detector #(
             if (c_valid && !c_has_next) state <= S_CP;
           end
         end
+        // second = max_{j != best} Q_j re-read from the memory (pipelined: r_v, r_j)
+        S_R2: if (r_end) begin
+          state <= S_CP;
+          j <= {JB{1'b0}};
+        end else begin
+          j <= (j == JLAST) ? {JB{1'b0}} : j + 1'b1;
+        end
         S_CP: if (cp_end) state <= (cp_kind || c_valid) ? S_IDLE : S_EA;
         S_EA: state <= S_EB;
         S_EB: state <= S_P0;
         S_P0: state <= S_P1;
-        S_P1: state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
+        S_P1: state <= S_P2;
+        S_P2: state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
         S_DIV: if (dv_cnt + 1'b1 == dv_k) state <= S_NEXT;
         S_NEXT: state <= (dsel == 2'd2) ? S_OUT : S_DIV;
         S_OUT: if (m_ready) state <= S_IDLE;
@@ -409,12 +424,23 @@ module peak_detector #(
         best_q <= head;
         best <= j;
       end
-      // sidx is only read when a candidate is captured (second meaningful: CODES > 1)
-      if (first) second <= {QW{1'b0}};
-      else if (gt_best) begin second <= best_q; sidx <= best; end
-      else if (gt_second) begin second <= head; sidx <= j; end
       nrm <= s_energy[ENERGY_W-1 -: NW];
       n_r <= s_index;
+    end
+    if (state == S_DECIDE) begin
+      best_q <= {QW{1'b0}};
+      s_found <= 1'b0;
+      r_v <= 1'b0;
+      r_end <= 1'b0;
+    end else if (state == S_R2) begin
+      r_v <= 1'b1;
+      r_j <= j;
+      r_end <= (j == JLAST);
+      if (r_v && gt_best && r_j != best) begin
+        best_q <= p_rd;
+        sidx <= r_j;
+        s_found <= 1'b1;
+      end
     end
     if (state == S_MAC && m_done && !m_mode) gate_r <= d_ge0 && min_ok;
     if (state == S_DECIDE && gate_r && (!c_valid || d_gt0)) begin
@@ -427,16 +453,20 @@ module peak_detector #(
       cp <= 2'd0;
     end else if (state == S_CP) cp <= cp + 1'b1;
     case (state)
-      S_EB: dv_d <= {{(W-QW){1'b0}}, p_rd};     // Q_prev
-      // dQ into dv_r, Q_prev + Q_next into dv_d (p_rd = Q_next)
-      S_P0: begin
+      // |dQ| and the sign of dQ = Q_next - Q_prev with one subtractor (p_rd - dv_d) used
+      // twice, no negation: Q_prev - Q_next, and Q_next - Q_prev if that was negative
+      S_EB: dv_d <= {{(W-QW){1'b0}}, p_rd};     // Q_next
+      S_P0: begin                               // p_rd = Q_prev
         dv_r <= {{(W-QW){1'b0}}, p_rd} - dv_d;
+        dv_d <= {{(W-QW){1'b0}}, p_rd};
+      end
+      S_P1: begin                               // p_rd = Q_next; dQ = 0 gives frac 0 either way
+        ev_neg <= !dv_r[W-1];
+        if (dv_r[W-1]) dv_r <= {{(W-QW){1'b0}}, p_rd} - dv_d;
         dv_d <= {{(W-QW){1'b0}}, p_rd} + dv_d;
       end
-      // |dQ| (restoring remainder), den = 4Q - 2(Q_prev + Q_next)
-      S_P1: begin
-        ev_neg <= dv_r[W-1];
-        dv_r <= dv_r[W-1] ? -dv_r : dv_r;
+      // den = 4Q - 2(Q_prev + Q_next)
+      S_P2: begin
         dv_d <= ({{(W-QW){1'b0}}, p_rd} << 2) - (dv_d << 1);
         dv_q <= {KM{1'b0}};
         dv_cnt <= {CW{1'b0}};
