@@ -7,7 +7,7 @@
 // own beat counter (framing).
 //
 // What it computes, per group {Q_j, E, n}:
-//   best = argmax_j Q_j (lowest j on ties), second = max_{j != best} Q_j   (scanned per beat)
+//   best = argmax_j Q_j (lowest j on ties, scanned per beat), second = max_{j != best} Q_j
 //   norm = E >> ENERGY_SHIFT;  gate = Q_best >= THRESHOLD * max(norm,1) && norm >= MIN_NORM
 //   a pending candidate whose right neighbour is unknown takes Q_next = Q_code(this group)
 //   if gate && (no candidate || Q_best * max(norm_cand,1) > Q_cand * max(norm,1)):
@@ -19,11 +19,15 @@
 //   0 when the denominator is <= 0; arrival = n 2^FRAC_W + DECIM frac (signed).
 //
 // Architecture (sequential, one SB_MAC16, one EBR-inferred memory):
-//  - Scan: each beat is compared with the running best / second as it arrives (one beat per
-//    clock while s_ready; the first beat of a group loads best and clears second), and written
-//    into a 2 x 2^clog2(CODES) x WEIGHTED_W memory (ping-pong by group parity: 3 EBR at 48
-//    bits), from which Q_prev = Q_best(previous group) is read once after the scan. No beat or
-//    group is captured in DFFs.
+//  - Scan: each beat is compared with the running best as it arrives (one beat per clock while
+//    s_ready; the first beat of a group loads best) and written into a 4 x 2^max(clog2(CODES),2)
+//    x WEIGHTED_W memory (3 EBR at 48 bits): halves 0 / 1 hold this and the previous group
+//    (ping-pong by group parity), region 2 the candidate's words Q_prev, Q, Q2, Q_next.
+//  - Capture: only when a candidate is taken, the group is re-read from the memory through the
+//    same comparator to find second = max_{j != best} (its index), then Q_prev, Q and Q2 are
+//    copied into region 2 through the read register (one word per clock); Q_next is copied
+//    the same way after the following group. No beat, group or candidate word is in DFFs;
+//    Q (the rho^2 operand), Q_prev, Q_next, Q2 are read back into the read register when used.
 //  - Both exact tests are D = A1*B1 - A2*B2 on one 16x16 multiplier (registered operands and
 //    product), gate: A1*B1 = Q_best*1, A2*B2 = THRESHOLD*norm1; rho^2 test: Q_best*norm1_cand
 //    - Q_cand*norm1. Partial products are summed column by column (16-bit digits, i+j = k) in
@@ -41,8 +45,9 @@
 //      else R < den holds and the remaining FRAC_W-1 steps give floor(X/den) < HALF exactly.
 //      The sign is applied afterwards (trunc toward zero = sign * floor(|X|/den)); den <= 0
 //      gives 0. Both rules equal the model's floor + min(cap) / trunc + clamp for every input.
-//  - dQ = Q_next - Q_prev and den = 4Q - 2(Q_prev + Q_next) are formed in two clocks (one
-//    adder each per clock) in the divider's registers.
+//  - |dQ| = |Q_next - Q_prev| uses one subtractor twice (Q_prev - Q_next, then Q_next -
+//    Q_prev if that was negative: no negation adder), then Q_prev + Q_next and den = 4Q -
+//    2(Q_prev + Q_next), one adder each per clock, in the divider's registers.
 //  - Output: the event is presented in S_OUT straight from the registers that computed it
 //    (code from the candidate, score from sc1, margin = sc1 - second score on one 16-bit
 //    subtractor, arrival = n 2^FRAC_W + DECIM frac written into the divisor register dv_d in the
@@ -53,24 +58,27 @@
 // rounding; nothing can overflow.
 // Latency / throughput (CODES=9, 48-bit Q, 29-bit norm: NA=3, NB=2 digits): a group takes
 // CODES clocks of beats (one per clock, fewer if s_valid has gaps) + (2 NA NB + 3) [gate] +
-// (2 NA NB + 3) [rho^2 test, only when the gate passes and a candidate exists] + 1 = 40 clocks
-// at most; an event adds 2 + FRAC_W + 1 + 2 (SCORE_W + 2) + 1 = 48 clocks, so a group with an
-// event is done in <= 88 clocks after its first beat (measured by tb_peak_detector: 88 on the
-// edge-case stream, 73 on the paced coded stream) < the 120 between the bank's groups (DECIM
-// 20 x 6 clocks): s_ready is high whenever the bank starts a group and stays high for its
-// CODES beats. s_ready is low while a group's tests or an event are processed and while the
+// (2 NA NB + 3) [rho^2 test, only when the gate passes and a candidate exists] + 1, plus
+// CODES + 1 + 4 on a capture (re-read, copies) or 2 when Q_next is copied; an event adds
+// 5 + FRAC_W + 1 + 2 (SCORE_W + 2) + 1 = 51 clocks (events and captures exclude each other),
+// so a group is done in <= 91 clocks after its first beat (measured by tb_peak_detector: 91 on
+// the edge-case stream, 76 on the paced coded stream) < the 120 between the bank's groups
+// (DECIM 20 x 6 clocks): s_ready is high whenever the bank starts a group and stays high for
+// its CODES beats. s_ready is low while a group's tests or an event are processed and while the
 // event waits for m_ready (back-pressure stalls the bank; nothing is lost).
 // Streams: valid/ready with AXI4-Stream rules (m_* stable while m_valid && !m_ready).
 // Reset: synchronous, active high, clears only the control state (state, beat counter,
-// candidate and MAC flags); data registers have no reset. The previous-group vector reads as
-// zeros until a group has been taken.
+// candidate and MAC flags); data registers and the memory have no reset. The previous-group
+// vector reads as zeros until a group has been taken (Q_prev is written as 0 then; so is Q2
+// when no j != best exceeds 0).
 // Resources (yosys 0.23 synth_ice40 -dsp of peak_detector alone with the default parameters of
-// generated/default/rtl/peak_detector.vc; module_stat.sh needs the regenerated receiver_top):
-// 1624 SB_LUT4, 660 DFF, 1 SB_MAC16, 3 SB_RAM40_4K (was 2046 / 1177 measured the same way with
-// the parallel input). The LUTs are mostly the divider (5 sources into its 51-bit remainder, 4
-// wide adders for dQ, den, |dQ| and the step; 3 sources into dv_d), the MAC digit multiplexers
-// and accumulator, the two scan comparators, the holdoff test (n - n_cand >= HOLDOFF) and the
-// arrival adder.
+// generated/default/rtl/peak_detector.vc, then nextpnr-ice40 --up5k --pack-only): 1636 logic
+// cells (1128 LUT4 only, 251 LUT4+DFF, 188 DFF only, 57 carry only, 11 carry legalisation),
+// 1 SB_MAC16, 3 SB_RAM40_4K (was 2057 LCs before the candidate words moved into the memory).
+// The LUTs are mostly the divider (sources into its 51-bit remainder and divisor, the dQ / sum
+// / den adders and the step), the MAC digit multiplexers and accumulator, the scan comparator,
+// the holdoff test (n - n_cand >= HOLDOFF, compared on HOLDOFF's significant bits only) and
+// the arrival adder.
 `default_nettype none
 
 module peak_detector #(
