@@ -26,12 +26,13 @@
 //
 // Architecture: a front end and a back end with three engines sharing one multiplier.
 //   Front end (6 clocks per input sample): one signed DATA_W x max(LO_W,DATA_W) multiplier
-//     (registered operands and product) does y*cos, y*-sin, y*y and y_old*y_old; the B and y
+//     (registered operands and product) does y*y, y*cos, y*-sin and y_old*y_old in that
+//     order, cos / -sin from a ROM (its read address one clock ahead); the B and y
 //     histories are memories; E += y^2 and E -= y_old^2 share one adder. After the last
 //     input of a decimation group, the hand-off clock (which also accepts the next input,
 //     so it costs no extra cycle unless the back end is more than one output behind or
 //     three outputs' E are unread; then the front end waits) writes Bd = acc into the Bd
-//     history and pushes E into the 3-entry energy ring.
+//     history and pushes E into the energy ring (a 4-word memory, at most 3 entries).
 //   Back end: ONE unsigned 16x16 multiplier (registered limb operands, registered product)
 //     in sign-magnitude: every wide operand is split into 16-bit limbs of its magnitude, the
 //     limb product is shifted by 16 (la+lb) and added or subtracted (one adder: the product
@@ -48,9 +49,10 @@
 //       the Cq registers (and code j's word of the group buffer's Cq memory) and clears
 //       them: CHIPS + 2 clocks per round, (CHIPS + 2) CODES per output (81 at the
 //       defaults, within the 120).
-//     SQ: Re^2 + Im^2 per code (2 ceil(CORR_W/16)^2 limb products) into P.
+//     SQ: Re^2 + Im^2 per code (2 ceil(CORR_W/16)^2 limb products) into P (one register,
+//       read by W: a code's SQ starts only when W has issued the previous code's products).
 //     W: P * w_j (ceil(2 CORR_W/16) x ceil(WEIGHT_W/16) limb products), the last sum
-//       written straight into code j's word of the group buffer's Q memory.
+//       written from the Q accumulator into code j's word of the group buffer's Q memory.
 //     The FIR of output k+1 runs in the clocks the SQ/W engines of output k leave free.
 //   Output: a ping-pong group buffer, two synchronous-read memories (Q: WEIGHTED_W, Cq:
 //     2 CORR_W wide) of 2 banks x 2^ceil(log2 CODES) words, address {bank, j}. The back end
@@ -58,8 +60,9 @@
 //     beat by beat, the read address looking one beat ahead (the address of the beat
 //     shown next clock), so m_weighted / m_corr are the memories' output registers and do
 //     not change while a beat waits. The back end starts a new group only when a bank is
-//     free (not while two finished groups are unread). E of each group waits in a 3-entry
-//     ring from the hand-off until the consumer takes the group's last beat; n is a
+//     free (not while two finished groups are unread). E of each group waits in the energy
+//     ring (a memory read one group ahead: m_energy is its output register) from the
+//     hand-off until the consumer takes the group's last beat; n is a
 //     counter advanced by DECIM at that beat; F (debug) is one register pair per bank.
 //     The memories are marked no_rw_check: a read of the word being written can only
 //     happen on a word the consumer does not look at (a bank with no finished group, or a
@@ -84,17 +87,21 @@
 // Multipliers (synth_ice40 -dsp): 2 SB_MAC16 at the defaults (front 16x16 signed, back 16x16
 //   unsigned). Memories (synchronous read, no reset, EBR): B history PERIOD x 2 MIX_W,
 //   y history WINDOW x DATA_W (y, not y^2: y_old^2 is recomputed), Bd history (TAPS+1) x
-//   2 DEC_W, F history ((CHIPS-1) CHIP_STEP + 1) x 2 CHIP_W, group buffer Q and Cq (above).
+//   2 DEC_W, F history ((CHIPS-1) CHIP_STEP + 1) x 2 CHIP_W, group buffer Q and Cq (above),
+//   energy ring 4 x ENERGY_W, LO ROM 2 PERIOD x max(LO_W,DATA_W).
 //   Histories are cleared lazily: a fill flag/counter per history masks entries not
 //   written since reset to zero, so after reset the outputs equal a fresh model's without a
 //   clearing pass. The group buffer is not cleared: its words are undefined while m_valid
 //   is low (AXI-Stream allows it).
 // Resources (yosys 0.23 synth_ice40 -dsp, defaults):
-//   /work/notes/module_stat.sh correlator_bank (-noflatten, debug outputs kept):
-//     2 SB_MAC16, 18 SB_RAM40_4K (2 of them the Cq debug memory), 1799 SB_LUT4, 883 DFF;
-//   flattened with m_corr / m_chip unconnected (as in the system):
-//     2 SB_MAC16, 16 SB_RAM40_4K, 1752 SB_LUT4, 803 DFF.
-//   Was 2 / 13 / 1847 / 1860 (flattened 1815 / 1532 measured the same way) with the
+//   flattened with m_corr / m_chip unconnected (as in the system), then
+//   nextpnr-ice40 --up5k --pack-only:
+//     2 SB_MAC16, 20 SB_RAM40_4K, 1581 SB_LUT4, 589 DFF, 1770 LCs (1126 LUT-only, 455
+//     LUT+DFF, 134 DFF-only, 89 carry-only).
+//   Was 2 / 16 / 1768 / 803, 2227 LCs, with the energy ring and LO tables in DFF/LUT logic,
+//   a separate P accumulator and registers that copied (y, and the Q / F / mix words fanning
+//   out of one LUT to two registers); before that 2 / 13 / 1847 / 1860 (flattened 1815 /
+//   1532) with the
 //   parallel CODES x WEIGHTED_W output register, 7 / 13 / 4217 / 2520 before the
 //   shared-multiplier design.
 //
@@ -107,7 +114,10 @@
 //     complete; the next one follows without a gap when it is finished too. No output is
 //     lost: with both banks full the back end waits (the FIR of the next output may run;
 //     then the front end waits).
-// Reset: synchronous, active high; clears every register, counter, phase and fill flag.
+// Reset: synchronous, active high; clears every control register, counter, phase, fill flag
+//   and accumulator whose value carries over (acc, E); datapath registers that are always
+//   loaded before they are read (multiplier operands, quantized words, accumulators started
+//   by a first product) are not reset.
 `default_nettype none
 
 // DATA_FRAC, MIX_FRAC, COMB_W and POWER_W are part of the documented interface (formats of
@@ -188,7 +198,6 @@ module correlator_bank #(
   localparam integer NC      = nlimbs(CORR_W);
   localparam integer NP      = nlimbs(PW_W);
   localparam integer NW      = nlimbs(WEIGHT_W);
-  localparam integer NWOP    = NP * NW;                     // W limb products per code
   localparam integer SHMAX   = imax(imax(NBA + NTB - 2, 2 * NC - 2), NP + NW - 2);
   localparam integer SH_W    = wbits(SHMAX + 1);
   localparam integer XW      = imax(imax(FIR_W, PW_W), imax(WEIGHTED_W, 2 * LW)) + 1;
@@ -295,15 +304,6 @@ module correlator_bank #(
 
   // Constant tables read with a variable index: written as compare loops so synthesis sees a
   // small truth table of the index bits instead of a shifter over the whole parameter.
-  function [FB_W-1:0] lo_rom;
-    input [PERIOD*FB_W-1:0] tab;
-    input [PA_W-1:0] i;
-    integer t;
-    begin
-      lo_rom = 0;
-      for (t = 0; t < PERIOD; t = t + 1) if (i == t[PA_W-1:0]) lo_rom = tab[t*FB_W +: FB_W];
-    end
-  endfunction
   function [TAPM_W:0] tap_rom;  // {sign of g, |g|}
     input [TI_W-1:0] i;
     integer t;
@@ -385,7 +385,6 @@ module correlator_bank #(
   localparam [2:0] FE_IDLE = 3'd0, FE_M1 = 3'd1, FE_M2 = 3'd2, FE_M3 = 3'd3,
                    FE_M4 = 3'd4, FE_M5 = 3'd5, FE_HAND = 3'd6;
   reg [2:0] fe_state;
-  reg signed [DATA_W-1:0] y_r;
   reg signed [DATA_W-1:0] fa;
   reg signed [FB_W-1:0]   fb;
   reg signed [FP_W-1:0]   fp;
@@ -400,9 +399,8 @@ module correlator_bank #(
   reg [BA_W-1:0]          bd_wptr;
   reg [TI_W-1:0]          bd_cnt;
   reg                     bd_pend;
-  reg [ENERGY_W-1:0]      eq0, eq1, eq2;  // 3-entry ring of group energies
-  reg [1:0]               eq_n, eq_w, eq_r;
-  wire                    e_pop;   // the consumer took the last beat of eq0's group
+  reg [1:0]               eq_n, eq_w, eq_r;  // ring of group energies (up to 3 in e_mem)
+  wire                    e_pop;   // consumer took the oldest ring entry's last beat
   wire                    a_start; // FIR takes the pending Bd
 
   // B history (PERIOD x {re, im}) and y history (WINDOW x y): synchronous-read memories.
@@ -410,15 +408,35 @@ module correlator_bank #(
   reg [2*MIX_W-1:0] b_rd;
   (* no_rw_check *) reg [DATA_W-1:0]  y_mem [0:WINDOW-1];
   reg [DATA_W-1:0]  y_rd;
-  wire fe_write = (fe_state == FE_M4);
+  // y is written from fa in FE_M3 (its last clock as an operand; y_rd is not used after FE_M3)
   always @(posedge clk) begin
-    if (fe_write) begin
-      b_mem[b_ptr] <= {mix_re, mix_im};
-      y_mem[y_ptr] <= y_r;
-    end
+    if (fe_state == FE_M5) b_mem[b_ptr] <= {mix_re, mix_im};
+    if (fe_state == FE_M3) y_mem[y_ptr] <= fa;
     b_rd <= b_mem[b_ptr];
     y_rd <= y_mem[y_ptr];
   end
+  // Energy ring: 4-word synchronous-read memory (EBR) holding at most 3 group energies; the
+  // read address looks one group ahead, so e_rd is E of the group presented and stays put.
+  // A write never hits the word read for a presented group (at most 3 of 4 words are live).
+  (* ram_style = "block", no_rw_check *) reg [ENERGY_W-1:0] e_mem [0:3];
+  reg [ENERGY_W-1:0] e_rd;
+  wire [1:0] eq_r_nx = eq_r + {1'b0, e_pop};
+  always @(posedge clk) begin
+    if (hand) e_mem[eq_w] <= energy_new;
+    e_rd <= e_mem[eq_r_nx];
+  end
+  // LO table ROM (EBR): word 2p = cos[p], 2p+1 = -sin[p]; the address looks one clock ahead
+  // (cos while idle / accepting, -sin in FE_M1), phase changes only in FE_M5.
+  (* ram_style = "block" *) reg [FB_W-1:0] lo_mem [0:2*PERIOD-1];
+  reg [FB_W-1:0] lo_rd;
+  integer lo_t;
+  initial begin
+    for (lo_t = 0; lo_t < PERIOD; lo_t = lo_t + 1) begin
+      lo_mem[2*lo_t]     = LO_C[lo_t*FB_W +: FB_W];
+      lo_mem[2*lo_t + 1] = LO_NS[lo_t*FB_W +: FB_W];
+    end
+  end
+  always @(posedge clk) lo_rd <= lo_mem[{phase, fe_state == FE_M1}];
   // Bd history: written by the front end at a hand-off, read by the FIR.
   (* no_rw_check *) reg [2*DEC_W-1:0] bd_mem [0:BDN-1];
   reg [2*DEC_W-1:0] bd_rd;
@@ -451,27 +469,18 @@ module correlator_bank #(
   always @(posedge clk) begin
     if (rst) begin
       fe_state <= FE_IDLE;
-      y_r <= 0; fa <= 0; fb <= 0; fp <= 0;
-      mix_re <= 0; mix_im <= 0;
       acc_re <= 0; acc_im <= 0; energy <= 0;
       phase <= 0; b_ptr <= 0; b_full <= 1'b0; y_full <= 1'b0;
       y_ptr <= Y_LAST;  // the model pre-increments the window index
       dphase <= 0;
       bd_wptr <= BD_LAST; bd_cnt <= 0; bd_pend <= 1'b0;
-      eq0 <= 0; eq1 <= 0; eq2 <= 0; eq_n <= 2'd0; eq_w <= 2'd0; eq_r <= 2'd0;
+      eq_n <= 2'd0; eq_w <= 2'd0; eq_r <= 2'd0;
     end else begin
       if (a_start) bd_pend <= 1'b0;
       // energy ring (E of the groups handed off and not yet read): push at a hand-off, pop
       // when the consumer takes a group's last beat (both may happen at once)
-      if (hand) begin
-        case (eq_w)
-          2'd0: eq0 <= energy_new;
-          2'd1: eq1 <= energy_new;
-          default: eq2 <= energy_new;
-        endcase
-        eq_w <= (eq_w == 2'd2) ? 2'd0 : eq_w + 1'b1;
-      end
-      if (e_pop) eq_r <= (eq_r == 2'd2) ? 2'd0 : eq_r + 1'b1;
+      if (hand) eq_w <= eq_w + 1'b1;
+      eq_r <= eq_r_nx;
       if (hand && !e_pop) eq_n <= eq_n + 1'b1;
       else if (e_pop && !hand) eq_n <= eq_n - 1'b1;
       if (hand) begin
@@ -481,35 +490,39 @@ module correlator_bank #(
       end
       case (fe_state)
         FE_IDLE, FE_HAND: if (accept) begin
-          y_r <= s_data;
           fa <= s_data;
-          fb <= lo_rom(LO_C, phase);
+          fb <= {{(FB_W-DATA_W){s_data[DATA_W-1]}}, s_data};
           y_ptr <= y_ptr_next;  // y_rd holds y_mem[y_ptr] from FE_M2 on
           fe_state <= FE_M1;
         end else if (hand) begin
           fe_state <= FE_IDLE;
         end
         FE_M1: begin
-          fp <= fa * fb;  // y cos
-          fb <= lo_rom(LO_NS, phase);
+          fp <= fa * fb;  // y^2
+          fb <= lo_rd;    // cos
           fe_state <= FE_M2;
         end
         FE_M2: begin
-          fp <= fa * fb;  // y (-sin)
-          mix_re <= q_mix_fp;
-          fb <= {{(FB_W-DATA_W){y_r[DATA_W-1]}}, y_r};
+          fp <= fa * fb;  // y cos
+          energy <= energy_s[ENERGY_W:1];  // E + y^2
+          fb <= lo_rd;    // -sin
           fe_state <= FE_M3;
         end
-        FE_M3: begin
-          fp <= fa * fb;  // y^2
-          mix_im <= q_mix_fp;
+        FE_M3: begin    // y_mem written this cycle (from fa)
+          fp <= fa * fb;  // y (-sin)
+          mix_im <= q_mix_fp;  // re word; moves to mix_re next clock (one LUT fanout)
           fa <= y_old;
           fb <= {{(FB_W-DATA_W){y_old[DATA_W-1]}}, y_old};
           fe_state <= FE_M4;
         end
-        FE_M4: begin  // memories written this cycle (fe_write)
+        FE_M4: begin
           fp <= fa * fb;  // y_old^2
-          energy <= energy_s[ENERGY_W:1];
+          mix_re <= mix_im;
+          mix_im <= q_mix_fp;
+          fe_state <= FE_M5;
+        end
+        FE_M5: begin  // b_mem written this cycle
+          energy <= energy_s[ENERGY_W:1];  // E - y_old^2
           acc_re <= acc_re + {{(DEC_W-MIX_W){mix_re[MIX_W-1]}}, mix_re}
                            - {{(DEC_W-MIX_W){b_old_re[MIX_W-1]}}, b_old_re};
           acc_im <= acc_im + {{(DEC_W-MIX_W){mix_im[MIX_W-1]}}, mix_im}
@@ -522,10 +535,6 @@ module correlator_bank #(
           end
           if (y_ptr == Y_LAST) y_full <= 1'b1;
           phase <= (phase == P_LAST) ? {PA_W{1'b0}} : phase + 1'b1;
-          fe_state <= FE_M5;
-        end
-        FE_M5: begin
-          energy <= energy_s[ENERGY_W:1];
           if (dphase == D_LAST) begin
             dphase <= 0;
             fe_state <= FE_HAND;
@@ -623,7 +632,7 @@ module correlator_bank #(
   reg [JI_W-1:0]   cq_j;
   reg              sq_p;
   reg [LC_W-1:0]   sq_la, sq_lb;
-  reg [PW_W-1:0]   p_acc, p_w;
+  reg [PW_W-1:0]   p_w;
   reg              pw_valid;
   reg [JI_W-1:0]   pw_j;
   reg [LP_W-1:0]   w_la;
@@ -634,16 +643,16 @@ module correlator_bank #(
   wire [NC*LW-1:0]  sq_mag_p = {{(NC*LW-CORR_W){1'b0}}, sq_mag};
   wire sq_first = !sq_p && (sq_la == {LC_W{1'b0}}) && (sq_lb == {LC_W{1'b0}});
   wire sq_last  = sq_p && (sq_la == NC_L) && (sq_lb == NC_L);
-  // P_w is written 2 clocks after a code's last SQ product issues: it may issue only if the
-  // W engine will have read the previous P_w by then.
-  wire sq_guard = (!(s1_v && s1_cl == CL_SQ && s1_last) || NWOP <= 1) &&
-                  (!(s2_v && s2_cl == CL_SQ && s2_last) || NWOP <= 2);
+  // SQ accumulates P in P_w, which the W engine reads while pw_valid: a code's first SQ
+  // product issues only when no SQ product is in flight (so P_w of the previous code is
+  // complete and pw_valid set) and pw_valid is low (W has issued all its products).
+  wire sq_idle = !(s1_v && s1_cl == CL_SQ) && !(s2_v && s2_cl == CL_SQ);
   wire [NP*LW-1:0]  pw_p = {{(NP*LW-PW_W){1'b0}}, p_w};
   wire [WTP_W-1:0]  wt = wt_rom(pw_j);
   wire w_last = (w_la == NP_L) && (w_lb == NW_L);
 
   wire w_iss  = pw_valid;
-  wire sq_iss = !pw_valid && cq_valid && (!sq_last || sq_guard);
+  wire sq_iss = !pw_valid && cq_valid && (!sq_first || sq_idle);
   // F_re is written 2 clocks after the last re product issues: only when fres is free.
   wire a_iss  = !w_iss && !sq_iss && a_busy && !(!a_lane && a_last && fres_valid);
 
@@ -661,7 +670,7 @@ module correlator_bank #(
   reg [WEIGHTED_W-1:0]    q_rd;
   reg [2*CORR_W-1:0]      c_rd;
   wire b_tags = (s1_v && s1_cl != CL_A) || (s2_v && s2_cl != CL_A);
-  wire b_done = b_busy && (c_state == C_IDLE) && !cq_valid && !pw_valid && !b_tags;
+  wire b_done = b_busy && (c_state == C_IDLE) && !cq_valid && !pw_valid && !b_tags && !q_we;
   assign b_start = !b_busy && fres_valid && (g_full != 2'd2);
   wire m_last_w = (rd_j == J_LAST);
   wire m_take   = (g_full != 2'd0) && m_ready;
@@ -672,7 +681,8 @@ module correlator_bank #(
   // beat's words and stay put while it is not taken.
   wire [JI_W-1:0] rd_j_nx    = !m_take ? rd_j : (m_last_w ? {JI_W{1'b0}} : rd_j + 1'b1);
   wire            rd_bank_nx = rd_bank ^ g_taken;
-  wire q_we = s2_v && (s2_cl == CL_W) && s2_last;
+  reg              q_we;   // q_acc holds the finished Q of code q_wj (written to q_mem)
+  reg [JI_W-1:0]   q_wj;
   wire c_we = (c_state == C_Q) && !cq_valid;
 
   // FIR read address: the Bd entry of the op presented next clock.
@@ -684,7 +694,7 @@ module correlator_bank #(
 
   wire [WEIGHTED_W-1:0] q_sum = (s2_first ? {WEIGHTED_W{1'b0}} : q_acc) + psh[WEIGHTED_W-1:0];
   always @(posedge clk) begin
-    if (q_we) q_mem[{wr_bank, s2_j}] <= q_sum;
+    if (q_we) q_mem[{wr_bank, q_wj}] <= q_acc;
     if (c_we) c_mem[{wr_bank, c_j}] <= {cq_re_n, cq_im_n};
     q_rd <= q_mem[{rd_bank_nx, rd_j_nx}];
     c_rd <= c_mem[{rd_bank_nx, rd_j_nx}];
@@ -702,17 +712,17 @@ module correlator_bank #(
       s1_neg <= 1'b0; s2_neg <= 1'b0; s1_lane <= 1'b0; s2_lane <= 1'b0;
       s1_sh <= 0; s2_sh <= 0; s1_j <= 0; s2_j <= 0;
       a_busy <= 1'b0; a_lane <= 1'b0; a_base <= 0; a_addr <= 0; a_cnt <= 0; a_i <= 0;
-      a_la <= 0; a_lb <= 0; facc <= 0; fq_pend <= 1'b0; fq_lane <= 1'b0;
-      fres_re <= 0; fres_im <= 0; fres_valid <= 1'b0;
+      a_la <= 0; a_lb <= 0; fq_pend <= 1'b0; fq_lane <= 1'b0;
+      fres_valid <= 1'b0;
       c_state <= C_IDLE; c_m <= 0; c_m1 <= 0; c_iss1 <= 1'b0; c_dv1 <= 1'b0;
       c_j <= 0; f_wptr <= F_LAST; f_rptr <= 0; f_old <= 0; f_cnt <= 0; f_dist <= 0;
       ca_re <= 0; ca_im <= 0;
-      cq_re <= 0; cq_im <= 0; cq_valid <= 1'b0;
+      cq_valid <= 1'b0;
       cq_j <= 0; sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
-      p_acc <= 0; p_w <= 0; pw_valid <= 1'b0; pw_j <= 0; w_la <= 0; w_lb <= 0; q_acc <= 0;
+      pw_valid <= 1'b0; pw_j <= 0; w_la <= 0; w_lb <= 0;
+      q_we <= 1'b0; q_wj <= 0;
       b_busy <= 1'b0; wr_bank <= 1'b0; rd_bank <= 1'b0; g_full <= 2'd0; rd_j <= 0;
       out_index <= DECIM_T - 1'b1;
-      chip_re0 <= 0; chip_im0 <= 0; chip_re1 <= 0; chip_im1 <= 0;
     end else begin
       rd_j <= rd_j_nx;
       rd_bank <= rd_bank_nx;
@@ -788,15 +798,16 @@ module correlator_bank #(
       // ---------------- product stage
       s2_v <= s1_v; s2_cl <= s1_cl; s2_first <= s1_first; s2_last <= s1_last;
       s2_neg <= s1_neg; s2_sh <= s1_sh; s2_j <= s1_j; s2_lane <= s1_lane;
+      q_we <= s2_v && (s2_cl == CL_W) && s2_last;
+      q_wj <= s2_j;
 
       // ---------------- land
       if (fq_pend) begin
         fq_pend <= 1'b0;
+        fres_im <= q_chip(facc);  // re word first, moved to fres_re with the im word
         if (fq_lane) begin
-          fres_im <= q_chip(facc);
+          fres_re <= fres_im;
           fres_valid <= 1'b1;
-        end else begin
-          fres_re <= q_chip(facc);
         end
       end
       if (s2_v) begin
@@ -809,14 +820,13 @@ module correlator_bank #(
             end
           end
           CL_SQ: begin
-            if (s2_first) p_acc <= psh[PW_W-1:0];
-            else if (s2_last) begin
-              p_w <= p_acc + psh[PW_W-1:0];
+            p_w <= (s2_first ? {PW_W{1'b0}} : p_w) + psh[PW_W-1:0];
+            if (s2_last) begin
               pw_valid <= 1'b1;
               pw_j <= s2_j;
-            end else p_acc <= p_acc + psh[PW_W-1:0];
+            end
           end
-          default: if (!s2_last) q_acc <= q_sum;  // the last sum goes to q_mem
+          default: q_acc <= q_sum;
         endcase
       end
 
@@ -892,7 +902,7 @@ module correlator_bank #(
   assign m_weighted = q_rd;
   assign m_code     = code_x[CODE_W-1:0];
   assign m_last     = m_last_w;
-  assign m_energy   = (eq_r == 2'd0) ? eq0 : (eq_r == 2'd1) ? eq1 : eq2;
+  assign m_energy   = e_rd;
   assign m_index    = out_index;
   assign m_chip_re  = rd_bank ? chip_re1 : chip_re0;
   assign m_chip_im  = rd_bank ? chip_im1 : chip_im0;
