@@ -34,7 +34,9 @@
 //   every read sits between writes so that depths are fixed, except the taps,
 //   whose depth counts the valid samples written since. With ROUNDING 0/1 the
 //   rounding constant is part of the initial sum (no quantizer adder).
-//   The accumulator keeps only the bits the COEFS bound needs (<= ACC_W).
+//   The accumulator keeps only the bits the COEFS bound needs: the final
+//   sum (plus the folded rounding constant) fits, so partial sums may wrap
+//   mod 2^bits (32 for the default filter, <= ACC_W + 1).
 //   Otherwise (general numerators): one multiplier per section, each section
 //   feeding its products b0*x0, b2*x2, [b1*x1], a2*y2, a1*y1 one per clock
 //   (b1 only if b1 != 0) into an ACC_W-bit adder/subtractor, sections
@@ -147,7 +149,7 @@ module bandpass_sos #(
   // here from COEFS (a narrower sum is exact: it is kept mod 2^bits and the
   // final value fits).
   function integer shared_acc_bits;
-    input integer dummy;
+    input integer fold;   // 1: plus the folded rounding constant (ROUNDING 1), one more bit allowed
     integer k, n;
     reg [COEF_W-1:0] c;
     reg [COEF_W+129:0] mag, bound, worst;
@@ -165,9 +167,11 @@ module bandpass_sos #(
         bound = bound + (mag << (DATA_W - 1));
         if (bound > worst) worst = bound;
       end
+      if (fold != 0 && ROUNDING == 1 && SHIFT > 0)
+        worst = worst + ({{(COEF_W+129){1'b0}}, 1'b1} << (SHIFT - 1));
       n = 1;
-      while (n < ACC_W && ((({{(COEF_W+129){1'b0}}, 1'b1}) << (n - 1)) - 1) < worst) n = n + 1;
-      shared_acc_bits = n + dummy;
+      while (n < ACC_W + fold && ((({{(COEF_W+129){1'b0}}, 1'b1}) << (n - 1)) - 1) < worst) n = n + 1;
+      shared_acc_bits = n;
     end
   endfunction
 
@@ -189,9 +193,12 @@ module bandpass_sos #(
     // the quantizer is wiring plus saturation; ROUNDING 2 needs the sum's bit
     // SHIFT first and keeps the adder. AC: accumulator register width.
     localparam FOLD = (ROUNDING != 2);
+    // Folded: the final sum plus the rounding constant must fit AC (mod 2^AC is
+    // exact then); with 32 bits or fewer SB_MAC16 holds the accumulator itself.
+    localparam integer AWF = shared_acc_bits(1);
     localparam integer ARW = ((AW > SHIFT + 1) ? AW : SHIFT + 1) + 1;
-    localparam integer AC = FOLD ? ARW : AW;
-    localparam integer AQW = ARW - SHIFT;
+    localparam integer AC = FOLD ? ((AWF > SHIFT + 2) ? AWF : SHIFT + 2) : AW;
+    localparam integer AQW = FOLD ? AC - SHIFT : ARW - SHIFT;
     localparam integer XW = (AC > PW) ? AC : PW;
     localparam [AC+COEF_W-1:0] RNDW = (ROUNDING == 1 && SHIFT > 0)
                                       ? ({{(AC+COEF_W-1){1'b0}}, 1'b1} << (SHIFT - 1)) : {(AC+COEF_W){1'b0}};
@@ -414,7 +421,7 @@ module bandpass_sos #(
           wire unused_fits = fits;
         end
       end else begin : g_noovf
-        assign y_new = {{(DATA_W - QW + 1){qq[AQW-1]}}, qq[QW-2:0]};
+        assign y_new = {{(DATA_W - AQW + 1){qq[AQW-1]}}, qq[AQW-2:0]};
       end
       assign pair_y[i*DATA_W +: DATA_W] = y_new;
 
