@@ -29,11 +29,19 @@
 //   sample is selected at D_j = 2 + 13*(j/2) + 9*(j%2) clocks after section 0
 //   takes it, its a2, a1 products the 2 clocks before, its output written 4
 //   clocks after D_j. The cascade state is one output history per section
-//   (depth 2-3, the first section's deeper: the output taps read it), plus 3
-//   input words; a period without input is a bubble that writes nothing, and
-//   every read sits between writes so that depths are fixed, except the taps,
-//   whose depth counts the valid samples written since. With ROUNDING 0/1 the
-//   rounding constant is part of the initial sum (no quantizer adder).
+//   (depth 2-3), plus 3 input words; a period without input is a bubble that
+//   writes nothing, and every read sits between writes so that depths are
+//   fixed. The multiplier operands read the histories of a pair's two
+//   sections from one small EBR per pair (16 words: a 4-word ring per
+//   section and a zero word; two synchronous read ports, so yosys uses two
+//   SB_RAM40_4K, one for a lone last section), each read issued the clock
+//   before its slot; words not written since reset read the zero word (the
+//   EBR is never cleared). Only the newest word of every section is also a
+//   register (the next pair reads its x0 the clock after it is written; and
+//   m_data). The m_sections taps keep register shift histories that exist
+//   only when the port is connected: a tap's depth counts the valid samples
+//   written since. With ROUNDING 0/1 the rounding constant is part of the
+//   initial sum (no quantizer adder).
 //   The accumulator keeps only the bits the COEFS bound needs: the final
 //   sum (plus the folded rounding constant) fits, so partial sums may wrap
 //   mod 2^bits (32 for the default filter, <= ACC_W + 1).
@@ -52,8 +60,10 @@
 //            slot. Otherwise sum over sections of (P_k + 3), plus SECTIONS - 1
 //            (39 for 5 sections with P = 4).
 //
-// Resources (yosys synth_ice40 -dsp, default configuration): shared 3 SB_MAC16,
-//            ~700 LUT4, ~400 DFF (was 5 SB_MAC16, 1724 LUT4, 1363 DFF).
+// Resources (default configuration, shared): 3 SB_MAC16, 5 SB_RAM40_4K (one
+//            per EBR read port), 715 logic cells with m_sections unconnected
+//            (yosys synth_ice40 -dsp -flatten, nextpnr-ice40 --pack-only; 849
+//            with register histories).
 //
 // Bit growth: products COEF_W + DW bits; accumulator ACC_W bits, which the
 //            model (validate / bandpass_min_acc_bits) proves holds
@@ -82,7 +92,8 @@
 //            [k*DATA_W +: DATA_W] (debug tap; m_data is the last word).
 //
 // Reset:     synchronous, active high; clears all filter state (x and y
-//            histories to zero), the pipeline and the output registers.
+//            histories read as zero: the EBR words count as unwritten), the
+//            pipeline and the output registers.
 //
 ////////////////////////////////////////////////////////////////////////////////
 `default_nettype none
@@ -215,6 +226,7 @@ module bandpass_sos #(
     wire [SECTIONS*HDMAX*DATA_W-1:0] hv;    // section j output history, depth d at (j*HDMAX+d)*DATA_W
     wire [NP*DATA_W-1:0]  pair_y;
     wire [SECTIONS-1:0]   wr;
+    wire [NP*DATA_W-1:0]  q_rd;     // pair i's second EBR read port (x2 words)
 
     assign s_ready = !xin_full;
     assign m_valid = out_valid;
@@ -290,7 +302,7 @@ module bandpass_sos #(
       assign m_sections[j*DATA_W +: DATA_W] = h[cnt*DATA_W +: DATA_W];
     end
     assign m_data = hv[(SECTIONS-1)*HDMAX*DATA_W +: DATA_W];
-    wire unused_hv = &{1'b0, hv};  // depths nobody reads
+    wire unused_hv = &{1'b0, hv, q_rd};  // depths nobody reads; the last pair's x2 port
 
     // ---- pairs: one multiplier, one accumulator, one quantizer each ---------
     genvar i;
@@ -315,40 +327,102 @@ module bandpass_sos #(
       wire unused_rr = rr[3];
       // Operands (sign-extended to DW): section a reads signal A (its input) and
       // A+1 (its output history); section b reads A+1 and B+1.
+      // Operands: section a's input words x0 (signal A: the input register or
+      // section A-1's newest word, kept in a register anyway for m_data/m_sections)
+      // and x2 (in2, or pair i-1's second read port); the histories of sections
+      // A and B live in one small EBR (two read ports: yosys duplicates it).
       wire [DW-1:0] a_x0, a_x2;
       if (i == 0) begin : g_in
         assign a_x0 = xin_a;
         assign a_x2 = in2_a;
       end else begin : g_prev
         wire [DATA_W-1:0] p0 = hv[((A-1)*HDMAX+0)*DATA_W +: DATA_W];
-        wire [DATA_W-1:0] p2 = hv[((A-1)*HDMAX+2)*DATA_W +: DATA_W];
         assign a_x0 = sx(p0);
-        assign a_x2 = sx(p2);
+        assign a_x2 = sx(q_rd[(i-1)*DATA_W +: DATA_W]);
       end
-      wire [DATA_W-1:0] ay1 = hv[(A*HDMAX+0)*DATA_W +: DATA_W];
-      wire [DATA_W-1:0] ay2 = hv[(A*HDMAX+1)*DATA_W +: DATA_W];
-      wire [DATA_W-1:0] ay3 = hv[(A*HDMAX+2)*DATA_W +: DATA_W];
-      wire [DATA_W-1:0] by1, by2;
-      if (HAS_B) begin : g_b
-        assign by1 = hv[(B*HDMAX+0)*DATA_W +: DATA_W];
-        assign by2 = hv[(B*HDMAX+1)*DATA_W +: DATA_W];
-      end else begin : g_nob
-        assign by1 = {DATA_W{1'b0}};
-        assign by2 = {DATA_W{1'b0}};
+      // ---- history EBR: words 0-3 ring of section A, 4-7 ring of B, 8 zero --
+      // A read is issued one clock before its slot (synchronous read) at
+      // wp + (write now) - 1 - depth, so it returns the word the slot's depth
+      // names after this clock's write; depth 0 is never read in the clock
+      // after its section's write. Words not written since reset read word 8.
+      wire wr_a = wr[A];
+      wire wr_b;
+      if (HAS_B) begin : g_wrb
+        assign wr_b = wr[B];
+      end else begin : g_nowrb
+        assign wr_b = 1'b0;
       end
+      reg [1:0] wp_a, wp_b;                 // write pointers
+      reg [2:0] vd_a, vd_b;                 // vd[k]: more than k words written since reset
+      (* no_rw_check *) reg [DATA_W-1:0] hmem [0:15];
+      reg [DATA_W-1:0] prd, qrd;
+      integer mi;
+      initial begin
+        for (mi = 0; mi < 16; mi = mi + 1) hmem[mi] = {DATA_W{1'b0}};
+      end
+      // Address of depth d after this clock (w: the section writes now): ring
+      // word wp - (1 + d - w) (mod 4, table, no adder), or word 8 if not written.
+      function [3:0] raddr;
+        input       sec, w, clr;
+        input [1:0] wp;
+        input [2:0] vd;
+        input [1:0] d;
+        reg   [1:0] k, a;
+        reg         ok;
+        begin
+          k = (d == 2'd0) ? (w ? 2'd0 : 2'd1) : (d == 2'd1) ? (w ? 2'd1 : 2'd2) : (w ? 2'd2 : 2'd3);
+          case (k)
+            2'd0:    a = wp;
+            2'd1:    a = {wp[1] ^ ~wp[0], ~wp[0]};
+            2'd2:    a = {~wp[1], wp[0]};
+            default: a = {wp[1] ^ wp[0], ~wp[0]};
+          endcase
+          ok = (d == 2'd0) ? (w | vd[0]) : (d == 2'd1) ? (w ? vd[0] : vd[1]) : (w ? vd[1] : vd[2]);
+          raddr = (clr || !ok) ? 4'd8 : {1'b0, sec, a};
+        end
+      endfunction
+      wire [2:0] nr = (r == 3'd5) ? 3'd0 : r + 3'd1;    // the slot the read is for
+      reg  [3:0] pa;
+      always @(*) begin
+        case (nr)
+          3'd0:    pa = raddr(1'b0, wr_a, rst, wp_a, vd_a, 2'd1);
+          3'd3:    pa = raddr(1'b1, wr_b, rst, wp_b, vd_b, 2'd1);
+          3'd4:    pa = raddr(1'b1, wr_b, rst, wp_b, vd_b, 2'd0);
+          default: pa = raddr(1'b0, wr_a, rst, wp_a, vd_a, 2'd0);
+        endcase
+      end
+      // second port: A depth 2 for slot 5 (b's x2), B depth 2 for slot 3 (pair i+1's a x2)
+      wire [3:0] qa = (nr == 3'd3) ? raddr(1'b1, wr_b, rst, wp_b, vd_b, 2'd2)
+                                   : raddr(1'b0, wr_a, rst, wp_a, vd_a, 2'd2);
+      always @(posedge clk) begin
+        if (wr_a || wr_b) hmem[{1'b0, wr_b, wr_b ? wp_b : wp_a}] <= pair_y[i*DATA_W +: DATA_W];
+        if (run || rst) begin
+          prd <= hmem[pa];
+          qrd <= HAS_B ? hmem[qa] : {DATA_W{1'b0}};  // a lone last section needs no x2 port
+        end
+        if (rst) begin
+          wp_a <= 2'd0; wp_b <= 2'd0; vd_a <= 3'd0; vd_b <= 3'd0;
+        end else begin
+          if (wr_a) begin wp_a <= {wp_a[1] ^ wp_a[0], ~wp_a[0]}; vd_a <= {vd_a[1:0], 1'b1}; end
+          if (wr_b) begin wp_b <= {wp_b[1] ^ wp_b[0], ~wp_b[0]}; vd_b <= {vd_b[1:0], 1'b1}; end
+        end
+      end
+      assign q_rd[i*DATA_W +: DATA_W] = qrd;
+
       reg  [DW-1:0]     p, qv;
       reg  [COEF_W-1:0] cf;
       reg               dsel;            // D product: q is x2, else q = ~p
       always @(*) begin
-        dsel = 1'b0; qv = a_x2;
+        dsel = (r == 3'd2) || (r == 3'd5);
+        p = (r == 3'd2) ? a_x0 : sx(prd);
+        qv = (r == 3'd2) ? a_x2 : sx(qrd);
         case (r)
-          3'd0:    begin p = sx(ay2); cf = NA2A; end
-          3'd1:    begin p = sx(ay1); cf = NA1A; end
-          3'd2:    begin p = a_x0; cf = B0A2; dsel = 1'b1; end
-          3'd3:    begin p = sx(by2); cf = NA2B; end
-          3'd4:    begin p = sx(by1); cf = NA1B; end
-          default: begin p = sx(ay1); cf = B0B2; dsel = 1'b1;
-                         qv = sx(ay3); end
+          3'd0:    cf = NA2A;
+          3'd1:    cf = NA1A;
+          3'd2:    cf = B0A2;
+          3'd3:    cf = NA2B;
+          3'd4:    cf = NA1B;
+          default: cf = B0B2;
         endcase
         if (!dsel) qv = ~p;              // (p - ~p) >> 1 == p exactly
       end
