@@ -74,14 +74,21 @@ module tx_scheduler #(
   reg [HW-1:0]     ph;         // 2 CYC s mod 2 SPC
 
   wire [CODES*CHIPS-1:0] code_bits = CODE_BITS;
-  wire chip_bit = code_bits[code_idx * CHIPS + chip];
+  // The chip lookups (a CODES*CHIPS-to-1 multiplexer) are registered every clock: code_idx and
+  // chip change only on a tick and ticks are at least 2 clocks apart (CLK_DIV >= 2), so at the
+  // next tick they are current, and the lookup is off the tick's critical path.
+  reg chip_bit, first_positive;
+  always @(posedge clk) begin
+    chip_bit <= code_bits[code_idx * CHIPS + chip];
+    first_positive <= code_bits[code_idx * CHIPS];
+  end
   // (c+1) SPC mod 2 SPC: 0 for a chip 1, SPC for a chip 0.
   wire [HW:0] ph_full = {1'b0, ph} + (chip_bit ? {(HW+1){1'b0}} : SPC[HW:0]);
   wire [HW:0] ph_mod  = ph_full >= 2 * SPC ? ph_full - 2 * SPC : ph_full;
   wire        positive = ph_mod < SPC;
 
-  // First sample of a burst: chip 0 of the code about to start, phase 0: +1 for a chip 1.
-  wire first_positive = code_bits[code_idx * CHIPS];
+  // First sample of a burst: chip 0 of the code about to start, phase 0: +1 for a chip 1
+  // (first_positive, registered above).
   wire start_now = tick && (t == 0) && enable;
   wire [HW:0] ph_step = {1'b0, ph} + 2 * CYC;
 
