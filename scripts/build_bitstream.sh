@@ -124,7 +124,9 @@ if [[ $pnr_ok == 1 ]]; then
   icepack "$out/ice40_top.asc" "$out/ranging_icebreaker.bin" || die "icepack failed"
   bin="$out/ranging_icebreaker.bin"
   log "icetime"
-  icetime -d up5k -P sg48 -p "$pcf" -c "$clk_mhz" -t "$out/ice40_top.asc" >"$out/icetime.log" 2>&1 || true
+  # icetime's pcf reader takes neither set_io options (-nowarn) nor trailing comments.
+  sed -e 's/#.*//' -e 's/-nowarn //' "$pcf" | awk 'NF' >"$out/icetime.pcf"
+  icetime -d up5k -P sg48 -p "$out/icetime.pcf" -c "$clk_mhz" -t "$out/ice40_top.asc" >"$out/icetime.log" 2>&1 || true
 else
   log "nextpnr failed (the design does not fit or route): see $out/nextpnr.log"
 fi
