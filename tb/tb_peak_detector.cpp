@@ -42,6 +42,16 @@
 
 namespace {
 
+// "event N: <what> {...} rtl {...}": the first differing event, for a failure message.
+std::string event_mismatch(std::size_t n, const char* what, const ranging::EventFixed& e,
+                           const ranging::EventFixed& g) {
+  std::ostringstream os;
+  os << "event " << n << ": " << what << " {code " << e.code << ", arrival " << e.arrival << ", score " << e.score
+     << ", margin " << e.margin << "} rtl {code " << g.code << ", arrival " << g.arrival << ", score " << g.score
+     << ", margin " << g.margin << "}";
+  return os.str();
+}
+
 using namespace ranging;
 
 const ReceiverDesign& design() {
@@ -220,11 +230,7 @@ void run_stream(DetSim& sim, const std::vector<std::int64_t>& y, double gap, dou
           fail("extra event code " + std::to_string(g.code) + " arrival " + std::to_string(g.arrival));
         } else if (!(g == events[got])) {
           const auto& e = events[got];
-          std::ostringstream os;
-          os << "event " << got << ": model {code " << e.code << ", arrival " << e.arrival << ", score "
-             << e.score << ", margin " << e.margin << "} rtl {code " << g.code << ", arrival " << g.arrival
-             << ", score " << g.score << ", margin " << g.margin << "}";
-          fail(os.str());
+          fail(event_mismatch(got, "model", e, g));
         }
         ++got;
         ++tot.events;
@@ -384,11 +390,7 @@ PacedResult run_paced(DetSim& sim, const std::vector<Beat>& beats, const std::ve
         fail("extra event");
       } else if (!(g == expected[got])) {
         const auto& e = expected[got];
-        std::ostringstream os;
-        os << "event " << got << ": expected {code " << e.code << ", arrival " << e.arrival << ", score "
-           << e.score << ", margin " << e.margin << "} rtl {code " << g.code << ", arrival " << g.arrival
-           << ", score " << g.score << ", margin " << g.margin << "}";
-        fail(os.str());
+        fail(event_mismatch(got, "expected", e, g));
       }
       ++got;
     }
