@@ -320,11 +320,15 @@ module bandpass_sos #(
       localparam [COEF_W-1:0] NA1A = -A1A, NA2A = -A2A, NA1B = -A1B, NA2B = -A2B;
       localparam [COEF_W-1:0] B0A2 = B0A << 1, B0B2 = B0B << 1;
 
-      localparam [3:0] PH4 = PH[3:0];
-      wire [3:0] rs = {1'b0, slot} + 4'd6 - PH4;
-      wire [3:0] rr = (rs >= 4'd6) ? rs - 4'd6 : rs;
-      wire [2:0] r = rr[2:0];
-      wire unused_rr = rr[3];
+      // r = (slot - PH) mod 6, kept in a register that steps with slot (no mod-6 adder in
+      // front of the operand muxes and the accumulator)
+      localparam integer R0_I = (6 - PH) % 6;
+      localparam [2:0] R0 = R0_I[2:0];
+      reg [2:0] r;
+      always @(posedge clk) begin
+        if (rst) r <= R0;
+        else if (run) r <= (r == 3'd5) ? 3'd0 : r + 3'd1;
+      end
       // Operands (sign-extended to DW): section a reads signal A (its input) and
       // A+1 (its output history); section b reads A+1 and B+1.
       // Operands: section a's input words x0 (signal A: the input register or

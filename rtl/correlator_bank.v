@@ -333,7 +333,9 @@ module correlator_bank #(
     end
   endfunction
 
-  // Quantizers: round half up by SHIFT, saturate to the output width, at real widths.
+  // Quantizers: round half up by SHIFT, saturate to the output width, at real widths. The
+  // saturation test is "the bits from the output's sign bit up are all equal" (a LUT tree), not
+  // two compares with MAX / MIN (two carry chains each); the result is the same.
   localparam integer QM_W = imax(FP_W, MIX_W) + 1;
   localparam integer QC_W = imax(FIR_W, CHIP_W) + 1;
   localparam integer QR_W = imax(CA_W, CORR_W) + 1;
@@ -343,21 +345,14 @@ module correlator_bank #(
   localparam [QM_W-1:0] HALF_M = (MIX_SHIFT > 0) ? ONE_M << imax(MIX_SHIFT - 1, 0) : {QM_W{1'b0}};
   localparam [QC_W-1:0] HALF_C = (CHIP_SHIFT > 0) ? ONE_C << imax(CHIP_SHIFT - 1, 0) : {QC_W{1'b0}};
   localparam [QR_W-1:0] HALF_R = (CORR_SHIFT > 0) ? ONE_R << imax(CORR_SHIFT - 1, 0) : {QR_W{1'b0}};
-  localparam signed [QM_W-1:0] MAX_M = $signed((ONE_M << (MIX_W - 1)) - ONE_M);
-  localparam signed [QC_W-1:0] MAX_C = $signed((ONE_C << (CHIP_W - 1)) - ONE_C);
-  localparam signed [QR_W-1:0] MAX_R = $signed((ONE_R << (CORR_W - 1)) - ONE_R);
-  localparam signed [QM_W-1:0] MIN_M = -MAX_M - $signed(ONE_M);
-  localparam signed [QC_W-1:0] MIN_C = -MAX_C - $signed(ONE_C);
-  localparam signed [QR_W-1:0] MIN_R = -MAX_R - $signed(ONE_R);
 
   function [MIX_W-1:0] q_mix;
     input [FP_W-1:0] x;
     reg signed [QM_W-1:0] t;
     begin
       t = $signed({{(QM_W-FP_W){x[FP_W-1]}}, x} + HALF_M) >>> MIX_SHIFT;
-      if (t > MAX_M) t = MAX_M;
-      else if (t < MIN_M) t = MIN_M;
-      q_mix = t[MIX_W-1:0];
+      q_mix = (&t[QM_W-1:MIX_W-1] || ~|t[QM_W-1:MIX_W-1]) ? t[MIX_W-1:0]
+                                                    : {t[QM_W-1], {(MIX_W-1){~t[QM_W-1]}}};
     end
   endfunction
   function [CHIP_W-1:0] q_chip;
@@ -365,9 +360,8 @@ module correlator_bank #(
     reg signed [QC_W-1:0] t;
     begin
       t = $signed({{(QC_W-FIR_W){x[FIR_W-1]}}, x} + HALF_C) >>> CHIP_SHIFT;
-      if (t > MAX_C) t = MAX_C;
-      else if (t < MIN_C) t = MIN_C;
-      q_chip = t[CHIP_W-1:0];
+      q_chip = (&t[QC_W-1:CHIP_W-1] || ~|t[QC_W-1:CHIP_W-1]) ? t[CHIP_W-1:0]
+                                                    : {t[QC_W-1], {(CHIP_W-1){~t[QC_W-1]}}};
     end
   endfunction
   function [CORR_W-1:0] q_corr;
@@ -375,9 +369,8 @@ module correlator_bank #(
     reg signed [QR_W-1:0] t;
     begin
       t = $signed({{(QR_W-CA_W){x[CA_W-1]}}, x} + HALF_R) >>> CORR_SHIFT;
-      if (t > MAX_R) t = MAX_R;
-      else if (t < MIN_R) t = MIN_R;
-      q_corr = t[CORR_W-1:0];
+      q_corr = (&t[QR_W-1:CORR_W-1] || ~|t[QR_W-1:CORR_W-1]) ? t[CORR_W-1:0]
+                                                    : {t[QR_W-1], {(CORR_W-1){~t[QR_W-1]}}};
     end
   endfunction
 

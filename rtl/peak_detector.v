@@ -57,7 +57,8 @@
 // arrival bits+1); DECIM * frac in FRAC_W+2+clog2(DECIM+1) bits; quotients as above. No
 // rounding; nothing can overflow.
 // Latency / throughput (CODES=9, 48-bit Q, 29-bit norm: NA=3, NB=2 digits): a group takes
-// CODES clocks of beats (one per clock, fewer if s_valid has gaps) + (2 NA NB + 3) [gate] +
+// CODES clocks of beats (one per clock, fewer if s_valid has gaps) + 1 (the scan compares
+// each beat a clock after taking it) + (2 NA NB + 3) [gate] +
 // (2 NA NB + 3) [rho^2 test, only when the gate passes and a candidate exists] + 1, plus
 // CODES + 1 + 4 on a capture (re-read, copies) or 2 when Q_next is copied; an event adds
 // 5 + FRAC_W + 1 + 2 (SCORE_W + 2) + 1 = 51 clocks (events and captures exclude each other),
@@ -152,9 +153,27 @@ module peak_detector #(
   localparam integer JLAST_I = CODES - 1;
   localparam [JB-1:0] JLAST = JLAST_I[JB-1:0];
   reg  [QW-1:0] p_rd;
-  // one comparator: the beat (scan) or the re-read word (S_R2) against best_q
-  wire [QW-1:0] cmp_in = (state == S_R2) ? p_rd : head;
-  wire gt_best = cmp_in > best_q;
+  // The running max (scan: the beats; S_R2: the re-read words of j != best) decides word k a
+  // clock after it arrives (h_*), from two compares made when it arrived: against best_q and
+  // against word k-1 (h_q then). If word k-1 was being decided in that same clock (pend), the
+  // one that applies is picked by that decision (won); so no compare sits between a memory
+  // read and best_q's update, and no decision waits on a compare.
+  reg            h_v, h_last, h_first, h_rv;
+  reg [JB-1:0]   h_j, h_rj;
+  reg [QW-1:0]   h_q;
+  reg            ca_r, cb_r, pend_r, won_r;
+  // selected by the state alone (not by take, which waits on the bank's output handshake); a
+  // word that is not taken is never decided on (h_v, h_rv low next clock)
+  wire [QW-1:0] cmp_src = (state == S_IDLE) ? head : p_rd;
+  // a > b as two half-width compares side by side (half the carry chain's delay)
+  localparam integer QH = QW / 2;
+  function gt_split;
+    input [QW-1:0] a, b;
+    begin
+      gt_split = (a[QW-1:QH] > b[QW-1:QH]) || (a[QW-1:QH] == b[QW-1:QH] && a[QH-1:0] > b[QH-1:0]);
+    end
+  endfunction
+  wire gt_best = (pend_r && won_r) ? cb_r : ca_r;   // word k > max of the words before it
 
   // ---------------------------------------------------------------- candidate
   reg                c_valid, c_has_next;
@@ -261,7 +280,7 @@ module peak_detector #(
   wire signed [AW-1:0] acc_sum = acc + (prod_x ^ {AW{s2}}) + {{(AW-1){1'b0}}, s2};
   wire d_ge0 = !acc[AW-1];
   // a MAC program starts: after the scan (gate) or after a passed gate with a candidate (rho^2)
-  wire m_start = (take && s_last) ||
+  wire m_start = (h_v && h_last) ||
                  (state == S_MAC && m_done && !m_mode && d_ge0 && min_ok && c_valid);
   wire d_gt0 = d_ge0 && ((acc != 0) || acc_nz);
 
@@ -274,7 +293,15 @@ module peak_detector #(
   reg [FR_W-1:0] fmag;
   reg [SCORE_W-1:0] sc1;
   wire [W:0]   dv_sh  = {dv_r, dv_q[KM-1]};
-  wire [W+1:0] dv_sub = {1'b0, dv_sh} - {2'b0, dv_d};
+  // dv_sh - dv_d as a carry-select subtractor: the low half and both versions of the high half
+  // (borrow in or not) side by side, then the low half's borrow picks one (half the chain)
+  localparam integer DH = (W + 1) / 2;                 // low-half bits
+  wire [DH:0]      sub_lo  = {1'b0, dv_sh[DH-1:0]} - {1'b0, dv_d[DH-1:0]};
+  wire [W+1-DH:0]  sh_hi   = {1'b0, dv_sh[W:DH]};
+  wire [W+1-DH:0]  d_hi    = {{(W+2-DH-(W-DH)){1'b0}}, dv_d[W-1:DH]};
+  wire [W+1-DH:0]  sub_hi0 = sh_hi - d_hi;
+  wire [W+1-DH:0]  sub_hi1 = sh_hi + ~d_hi;            // sh_hi - d_hi - 1
+  wire [W+1:0] dv_sub = {sub_lo[DH] ? sub_hi1 : sub_hi0, sub_lo[DH-1:0]};
   wire dv_ge = !dv_sub[W+1];
   wire [CW-1:0] dv_k = (dsel == 2'd0) ? KF : KS;
   wire [SCORE_W-1:0] score_now = dv_q[SCORE_W] ? CAP : dv_q[SCORE_W-1:0];
@@ -296,11 +323,17 @@ module peak_detector #(
   wire [CODE_W+JB-1:0] code_x = {{CODE_W{1'b0}}, c_code};
   /* verilator lint_on UNUSEDSIGNAL */
   // a candidate without Q_next takes it from this group (copied in S_CP), so it can emit now
-  wire [TIME_W-1:0] since = n_r - c_n;
+  // since = n - c_n and the hold-off test are pipelined over two clocks (since, emit): n_r,
+  // c_n and c_valid are stable through S_MAC (>= 2 NA NB + 3 clocks) before S_DECIDE reads emit
   localparam integer HB0 = $clog2(HOLDOFF + 1);            // significant bits of HOLDOFF
   localparam integer HB  = (HB0 < 1) ? 1 : HB0;
   localparam [HB-1:0] HOLD_LO = HOLD_T[HB-1:0];
-  wire emit = c_valid && (((since >> HB) != {TIME_W{1'b0}}) || since[HB-1:0] >= HOLD_LO);
+  reg [TIME_W-1:0] since;
+  reg emit;
+  always @(posedge clk) begin
+    since <= n_r - c_n;
+    emit <= c_valid && (((since >> HB) != {TIME_W{1'b0}}) || since[HB-1:0] >= HOLD_LO);
+  end
 
   // output: held in S_OUT (the registers it is computed from do not change there)
   localparam integer DECIM_I = DECIM;
@@ -320,7 +353,11 @@ module peak_detector #(
         if (DECIM_D[b]) times_decim = times_decim + (v << b);
     end
   endfunction
-  wire [FD_W-1:0] frac_d = times_decim(frac_x);
+  // registered every clock: fmag and ev_neg are final in S_NEXT of the fraction's division, and
+  // the arrival is read in S_NEXT of the second score's, a whole division later (keeps the
+  // negate, the shift-adds and the arrival adder out of one clock)
+  reg [FD_W-1:0] frac_d;
+  always @(posedge clk) frac_d <= times_decim(frac_x);
   wire signed [ARR_W-1:0] arrival = $signed({1'b0, c_n, {FRAC_W{1'b0}}})
                                   + $signed({{(ARR_W-FD_W){frac_d[FD_W-1]}}, frac_d});
 
@@ -342,7 +379,9 @@ module peak_detector #(
       c_valid <= 1'b0; c_has_next <= 1'b0;
       m_run <= 1'b0; m_done <= 1'b0;
       v1 <= 1'b0; v2 <= 1'b0; fin1 <= 1'b0; fin2 <= 1'b0;
+      h_v <= 1'b0;
     end else begin
+      h_v <= take;
       v2 <= v1; fin2 <= fin1; m_done <= fin2;
       v1 <= m_run;
       fin1 <= 1'b0;
@@ -407,7 +446,7 @@ module peak_detector #(
     s1 <= mp; e1 <= mp && (mi == i_hi);
     if (m_start) begin
       mk <= {KW{1'b0}}; mi <= {IW{1'b0}}; mp <= 1'b0;
-      m_mode <= (state == S_MAC);
+      m_mode <= !(h_v && h_last);
     end else if (m_run) begin
       mp <= ~mp;
       if (mp) begin
@@ -427,11 +466,23 @@ module peak_detector #(
       acc_nz <= acc_nz | (e2 && acc_sum[15:0] != 16'd0);
     end
     // scan, one beat per clock: strict > from the first beat on, lowest index on ties
+    h_q <= cmp_src;
+    ca_r <= gt_split(cmp_src, best_q);
+    cb_r <= gt_split(cmp_src, h_q);
+    pend_r <= h_v || h_rv;
+    won_r <= (h_v && (gt_best || h_first)) || (h_rv && gt_best && h_rj != best);
+    h_rv <= (state == S_R2) && r_v;
+    h_rj <= r_j;
     if (take) begin
-      if (gt_best || first) begin
-        best_q <= head;
-        best <= j;
-      end
+      h_j <= j;
+      h_first <= first;
+      h_last <= s_last;
+    end
+    if (h_v && (gt_best || h_first)) begin
+      best_q <= h_q;
+      best <= h_j;
+    end
+    if (take) begin
       nrm <= s_energy[ENERGY_W-1 -: NW];
       n_r <= s_index;
     end
@@ -444,11 +495,13 @@ module peak_detector #(
       r_v <= 1'b1;
       r_j <= j;
       r_end <= (j == JLAST);
-      if (r_v && gt_best && r_j != best) begin
-        best_q <= p_rd;
-        sidx <= r_j;
-        s_found <= 1'b1;
-      end
+    end
+    // the last re-read word is compared in S_CP's first clock; sidx is read at cp 2, s_found
+    // at cp 3
+    if (h_rv && gt_best && h_rj != best) begin
+      best_q <= h_q;
+      sidx <= h_rj;
+      s_found <= 1'b1;
     end
     if (state == S_MAC && m_done && !m_mode) gate_r <= d_ge0 && min_ok;
     if (state == S_DECIDE && gate_r && (!c_valid || d_gt0)) begin

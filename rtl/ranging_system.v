@@ -151,18 +151,18 @@ module ranging_system #(
   assign sample_tick = tick;
   assign meas_valid = m_valid & m_ready;
 
-  // Measurement LED: LED_HOLD clocks per measurement.
+  // Measurement LED: LED_HOLD clocks per measurement. An up-counter cleared by the event
+  // (one set/reset net for every bit) keeps its carry chain in one piece in the iCE40
+  // tiles; loading the constant LED_HOLD mixed set and reset nets and split the chain.
   localparam integer LW = $clog2(LED_HOLD + 1);
+  localparam [LW-1:0] LED_LAST = LED_HOLD - 1;
   reg [LW-1:0] led_count;
   always @(posedge clk) begin
-    if (rst) begin
-      led_count <= 0;
-      led_meas <= 1'b0;
-    end else begin
-      if (m_valid && m_ready) led_count <= LED_HOLD;
-      else if (led_count != 0) led_count <= led_count - 1'b1;
-      led_meas <= led_count != 0;
-    end
+    if (rst || (m_valid && m_ready)) led_count <= 0;
+    else if (led_meas) led_count <= led_count + 1'b1;
+    if (rst) led_meas <= 1'b0;
+    else if (m_valid && m_ready) led_meas <= 1'b1;
+    else if (led_count == LED_LAST) led_meas <= 1'b0;
   end
 
   wire unused = &{1'b0, overruns};

@@ -31,8 +31,9 @@
 //            Flags: bit 0 no burst of code j before the arrival (ToF and
 //            distance 0), bit 1 ToF or distance saturated.
 //
-// Timing:    sequential (no DSP): up to CODES-1 cycles to step back to code j's
-//            burst, 1-2 cycles for the ToF (one more per cycle stepped back),
+// Timing:    sequential (no DSP): 1 cycle to subtract the offset, up to CODES-1
+//            cycles to step back to code j's burst, 2-3 cycles for the ToF (its
+//            subtractor is registered; two more per cycle stepped back),
 //            TOF_W cycles of shift-add (one C_W+1-bit adder) multiply with the
 //            rounding term as its start value, 1 cycle to saturate the distance,
 //            then the result waits on m_ready. s_ready is high only when idle:
@@ -92,14 +93,15 @@ module tof_distance #(
   localparam integer LO_W = TOF_W - SH;               // product bits below hi that reach the distance
   localparam integer CNT_W = ($clog2(TOF_W) > KW + 1 ? $clog2(TOF_W) : KW + 1);
   localparam integer CYCLE = CODES * PERIOD_T;
-  localparam [2:0] IDLE = 0, BACK = 1, TOF = 2, MUL = 3, CLAMP = 4, OUT = 5;
+  localparam [2:0] IDLE = 0, BACK = 1, TOF = 2, MUL = 3, CLAMP = 4, OUT = 5, OFFS = 6, TOF0 = 7;
 
   reg [2:0] state;
   reg have_burst;
   reg [TIME_W-1:0] last_time;
   reg [CODE_W-1:0] last_code;
 
-  reg signed [AW-1:0] a;      // A = arrival - offset
+  reg signed [AW-1:0] a;      // A = arrival - offset (the arrival in OFFS)
+  reg signed [OFF_W-1:0] off_r;  // the code's offset, looked up in IDLE, subtracted in OFFS
   reg signed [TW-1:0] t;      // candidate burst start
   reg [CNT_W-1:0] cnt;        // BACK: periods left to step back; MUL: steps done
   reg no_tx, sat;
@@ -131,7 +133,10 @@ module tof_distance #(
 
   // one subtractor steps t back (a period in BACK, a cycle in TOF); its sign in TOF is t < CYCLE
   wire signed [TW-1:0] t_step = t - (state == BACK ? PERIOD_T : CYCLE);
-  wire signed [DW-1:0] tof_w = a - ($signed(t) <<< FRAC_W);
+  // A - t 2^FRAC_W, registered every clock (TOF0 waits for it after t changes): its wide
+  // subtractor and the saturation test into mplier are in different clocks
+  reg signed [DW-1:0] tof_w;
+  always @(posedge clk) tof_w <= a - ($signed(t) <<< FRAC_W);
   wire [C_W:0] hsum = {1'b0, hi} + (mplier[0] ? {1'b0, c_used} : {(C_W+1){1'b0}});
 
   always @(posedge clk) begin
@@ -149,9 +154,12 @@ module tof_distance #(
       end
       if (c_wr) c_current <= c_value;
       case (state)
-        IDLE: if (s_valid) state <= BACK;
-        BACK: if (cnt == 0) state <= TOF;
-        TOF: if (no_tx || (!t[TW-1] && !tof_w[DW-1])) state <= MUL;
+        IDLE: if (s_valid) state <= OFFS;
+        OFFS: state <= BACK;
+        BACK: if (cnt == 0) state <= TOF0;
+        TOF0: state <= TOF;
+        TOF: state <= (no_tx || (!t[TW-1] && !tof_w[DW-1])) ? MUL
+                     : (t[TW-1] || t_step[TW-1]) ? TOF : TOF0;  // stepped back: wait for tof_w
         MUL: if (cnt == TOF_W - 1) state <= CLAMP;
         CLAMP: state <= OUT;
         OUT: if (m_ready) state <= IDLE;
@@ -164,7 +172,8 @@ module tof_distance #(
   always @(posedge clk) begin
     case (state)
       IDLE: begin
-        a <= $signed(s_arrival) - off;
+        a <= $signed(s_arrival);
+        off_r <= off;
         t <= $signed({2'b00, last_time});
         cnt <= k0;
         no_tx <= !have_burst;
@@ -173,6 +182,7 @@ module tof_distance #(
         m_score <= s_score;
         m_margin <= s_margin;
       end
+      OFFS: a <= a - off_r;
       BACK: if (cnt != 0) begin
         t <= t_step;
         cnt <= cnt - 1'b1;
