@@ -27,7 +27,8 @@
 //            bytes are selected from the s_* inputs, which AXI4-Stream keeps stable
 //            while s_valid && !s_ready, and s_ready completes the handshake when
 //            the frame's last byte is handed to the transmitter (a 17:1 byte
-//            multiplexer instead of a 136-bit frame register).
+//            multiplexer instead of a 136-bit frame register). The checksum is a
+//            running XOR of the bytes as they are sent.
 //
 ////////////////////////////////////////////////////////////////////////////////
 `default_nettype none
@@ -54,15 +55,12 @@ module measurement_uart #(
   wire byte_ready;
 
   wire [8*14-1:0] payload = {s_margin, s_score, s_distance, s_tof, s_flags, s_code};
+  // checksum: XOR of bytes 2..15 accumulated as they are handed to the transmitter (one 8-bit
+  // register instead of a 14-input XOR tree per bit)
   reg [7:0] x;
-  integer i;
-  always @(*) begin
-    x = 8'h00;
-    for (i = 0; i < 14; i = i + 1) x = x ^ payload[8*i +: 8];
-  end
-  wire [8*BYTES-1:0] frame = {x, payload, 8'h5A, 8'hA5};
-  wire [7:0] byte_now = frame[8*idx +: 8];
+  wire [8*BYTES-1:0] frame = {8'h00, payload, 8'h5A, 8'hA5};
   wire last_byte = idx == BYTES - 1;
+  wire [7:0] byte_now = last_byte ? x : frame[8*idx +: 8];
 
   assign s_ready = busy && last_byte && byte_ready;
 
@@ -77,6 +75,8 @@ module measurement_uart #(
       if (last_byte) busy <= 1'b0;
       idx <= idx + 1'b1;
     end
+    if (!busy) x <= 8'h00;
+    else if (byte_ready && idx >= 2) x <= x ^ byte_now;  // byte 16 (x itself) is never added
   end
 
   uart_tx #(.BAUD_DIV(BAUD_DIV)) u_tx (

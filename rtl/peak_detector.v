@@ -179,6 +179,7 @@ module peak_detector #(
   reg                c_valid, c_has_next;
   reg [TIME_W-1:0]   c_n;
   reg [JB-1:0]       c_code;
+  reg [CODE_W-1:0]   c_code1;        // c_code + 1 (m_code, a register for the consumer)
   reg [NW-1:0]       c_norm1;
   reg                cp_kind, qp_zero;   // copy program: 1 capture (Qp, Q, Q2), 0 Q_next
   reg [1:0]          cp;
@@ -293,16 +294,30 @@ module peak_detector #(
   reg [FR_W-1:0] fmag;
   reg [SCORE_W-1:0] sc1;
   wire [W:0]   dv_sh  = {dv_r, dv_q[KM-1]};
-  // dv_sh - dv_d as a carry-select subtractor: the low half and both versions of the high half
-  // (borrow in or not) side by side, then the low half's borrow picks one (half the chain)
-  localparam integer DH = (W + 1) / 2;                 // low-half bits
-  wire [DH:0]      sub_lo  = {1'b0, dv_sh[DH-1:0]} - {1'b0, dv_d[DH-1:0]};
-  wire [W+1-DH:0]  sh_hi   = {1'b0, dv_sh[W:DH]};
-  wire [W+1-DH:0]  d_hi    = {{(W+2-DH-(W-DH)){1'b0}}, dv_d[W-1:DH]};
-  wire [W+1-DH:0]  sub_hi0 = sh_hi - d_hi;
-  wire [W+1-DH:0]  sub_hi1 = sh_hi + ~d_hi;            // sh_hi - d_hi - 1
-  wire [W+1:0] dv_sub = {sub_lo[DH] ? sub_hi1 : sub_hi0, sub_lo[DH-1:0]};
+  // dv_sh - dv_d as a carry-select subtractor in three segments: the low segment and both
+  // versions (borrow in or not) of the middle and top segments side by side, then the borrows
+  // pick them (a third of the carry chain)
+  localparam integer DS = (W + 3) / 3;                 // low and middle segment bits
+  localparam integer DT = W + 1 - 2 * DS;              // top segment bits of dv_sh
+  wire [W+1:0] sh_x = {1'b0, dv_sh};
+  wire [W+1:0] d_x  = {2'b00, dv_d};
+  wire [DS:0]  sub_lo  = {1'b0, sh_x[DS-1:0]} - {1'b0, d_x[DS-1:0]};
+  wire [DS:0]  sub_mi0 = {1'b0, sh_x[2*DS-1:DS]} - {1'b0, d_x[2*DS-1:DS]};
+  wire [DS:0]  sub_mi1 = {1'b0, sh_x[2*DS-1:DS]} + {1'b1, ~d_x[2*DS-1:DS]};   // - 1
+  wire [DT:0]  sub_hi0 = sh_x[W+1:2*DS] - d_x[W+1:2*DS];
+  wire [DT:0]  sub_hi1 = sh_x[W+1:2*DS] + ~d_x[W+1:2*DS];                      // - 1
+  wire         b_mi    = sub_lo[DS] ? sub_mi1[DS] : sub_mi0[DS];               // borrow out
+  wire [W+1:0] dv_sub  = {b_mi ? sub_hi1 : sub_hi0,
+                          sub_lo[DS] ? sub_mi1[DS-1:0] : sub_mi0[DS-1:0], sub_lo[DS-1:0]};
   wire dv_ge = !dv_sub[W+1];
+  // den = 4 Q - 2 (Q_prev + Q_next) (S_P2, mod 2^W) as a two-segment carry-select subtractor
+  localparam integer EH = W / 2;
+  wire [W-1:0]    den_a  = {{(W-QW){1'b0}}, p_rd} << 2;
+  wire [W-1:0]    den_b  = dv_d << 1;
+  wire [EH:0]     den_lo = {1'b0, den_a[EH-1:0]} - {1'b0, den_b[EH-1:0]};
+  wire [W-EH-1:0] den_h0 = den_a[W-1:EH] - den_b[W-1:EH];
+  wire [W-EH-1:0] den_h1 = den_a[W-1:EH] + ~den_b[W-1:EH];   // - 1
+  wire [W-1:0]    den_cs = {den_lo[EH] ? den_h1 : den_h0, den_lo[EH-1:0]};
   wire [CW-1:0] dv_k = (dsel == 2'd0) ? KF : KS;
   wire [SCORE_W-1:0] score_now = dv_q[SCORE_W] ? CAP : dv_q[SCORE_W-1:0];
   // quotient of the fraction division: its low FRAC_W bits (< HALF when the top one is 0)
@@ -320,7 +335,7 @@ module peak_detector #(
   wire [KM-1:0] q_lo  = q_lo_x[KM+SCORE_W -: KM];
 
   /* verilator lint_off UNUSEDSIGNAL */
-  wire [CODE_W+JB-1:0] code_x = {{CODE_W{1'b0}}, c_code};
+  wire [CODE_W+JB-1:0] best_x1 = {{CODE_W{1'b0}}, best} + 1'b1;
   /* verilator lint_on UNUSEDSIGNAL */
   // a candidate without Q_next takes it from this group (copied in S_CP), so it can emit now
   // since = n - c_n and the hold-off test are pipelined over two clocks (since, emit): n_r,
@@ -507,6 +522,7 @@ module peak_detector #(
     if (state == S_DECIDE && gate_r && (!c_valid || d_gt0)) begin
       c_n <= n_r;
       c_code <= best;
+      c_code1 <= best_x1[CODE_W-1:0];
       c_norm1 <= norm1;
     end
     if (state == S_DECIDE) begin
@@ -528,7 +544,7 @@ module peak_detector #(
       end
       // den = 4Q - 2(Q_prev + Q_next)
       S_P2: begin
-        dv_d <= ({{(W-QW){1'b0}}, p_rd} << 2) - (dv_d << 1);
+        dv_d <= den_cs;
         dv_q <= {KM{1'b0}};
         dv_cnt <= {CW{1'b0}};
         dsel <= 2'd0;
@@ -561,7 +577,7 @@ module peak_detector #(
   end
 
   assign m_valid   = (state == S_OUT);
-  assign m_code    = code_x[CODE_W-1:0] + 1'b1;
+  assign m_code    = c_code1;
   assign m_arrival = dv_d[ARR_W-1:0];
   assign m_score   = sc1;
   assign m_margin  = sc1 - score_now;

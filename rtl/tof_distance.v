@@ -31,9 +31,9 @@
 //            Flags: bit 0 no burst of code j before the arrival (ToF and
 //            distance 0), bit 1 ToF or distance saturated.
 //
-// Timing:    sequential (no DSP): 1 cycle to subtract the offset, up to CODES-1
-//            cycles to step back to code j's burst, 2-3 cycles for the ToF (its
-//            subtractor is registered; two more per cycle stepped back),
+// Timing:    sequential (no DSP): up to CODES-1 cycles to step back to code j's
+//            burst, 2-3 cycles for the ToF (its subtractor is registered; two
+//            more per cycle stepped back),
 //            TOF_W cycles of shift-add (one C_W+1-bit adder) multiply with the
 //            rounding term as its start value, 1 cycle to saturate the distance,
 //            then the result waits on m_ready. s_ready is high only when idle:
@@ -93,15 +93,14 @@ module tof_distance #(
   localparam integer LO_W = TOF_W - SH;               // product bits below hi that reach the distance
   localparam integer CNT_W = ($clog2(TOF_W) > KW + 1 ? $clog2(TOF_W) : KW + 1);
   localparam integer CYCLE = CODES * PERIOD_T;
-  localparam [2:0] IDLE = 0, BACK = 1, TOF = 2, MUL = 3, CLAMP = 4, OUT = 5, OFFS = 6, TOF0 = 7;
+  localparam [2:0] IDLE = 0, BACK = 1, TOF = 2, MUL = 3, CLAMP = 4, OUT = 5, TOF0 = 6;
 
   reg [2:0] state;
   reg have_burst;
   reg [TIME_W-1:0] last_time;
   reg [CODE_W-1:0] last_code;
 
-  reg signed [AW-1:0] a;      // A = arrival - offset (the arrival in OFFS)
-  reg signed [OFF_W-1:0] off_r;  // the code's offset, looked up in IDLE, subtracted in OFFS
+  reg signed [AW-1:0] a;      // A = arrival - offset
   reg signed [TW-1:0] t;      // candidate burst start
   reg [CNT_W-1:0] cnt;        // BACK: periods left to step back; MUL: steps done
   reg no_tx, sat;
@@ -133,6 +132,9 @@ module tof_distance #(
 
   // one subtractor steps t back (a period in BACK, a cycle in TOF); its sign in TOF is t < CYCLE
   wire signed [TW-1:0] t_step = t - (state == BACK ? PERIOD_T : CYCLE);
+  // sign of t - CYCLE, registered: TOF reads it after TOF0, where t has not changed
+  reg t_step_neg;
+  always @(posedge clk) t_step_neg <= t_step[TW-1];
   // A - t 2^FRAC_W, registered every clock (TOF0 waits for it after t changes): its wide
   // subtractor and the saturation test into mplier are in different clocks
   reg signed [DW-1:0] tof_w;
@@ -154,12 +156,11 @@ module tof_distance #(
       end
       if (c_wr) c_current <= c_value;
       case (state)
-        IDLE: if (s_valid) state <= OFFS;
-        OFFS: state <= BACK;
+        IDLE: if (s_valid) state <= BACK;
         BACK: if (cnt == 0) state <= TOF0;
         TOF0: state <= TOF;
         TOF: state <= (no_tx || (!t[TW-1] && !tof_w[DW-1])) ? MUL
-                     : (t[TW-1] || t_step[TW-1]) ? TOF : TOF0;  // stepped back: wait for tof_w
+                     : (t[TW-1] || t_step_neg) ? TOF : TOF0;  // stepped back: wait for tof_w
         MUL: if (cnt == TOF_W - 1) state <= CLAMP;
         CLAMP: state <= OUT;
         OUT: if (m_ready) state <= IDLE;
@@ -172,8 +173,7 @@ module tof_distance #(
   always @(posedge clk) begin
     case (state)
       IDLE: begin
-        a <= $signed(s_arrival);
-        off_r <= off;
+        a <= $signed(s_arrival) - off;  // s_code is a register: the lookup is one LUT level
         t <= $signed({2'b00, last_time});
         cnt <= k0;
         no_tx <= !have_burst;
@@ -182,7 +182,6 @@ module tof_distance #(
         m_score <= s_score;
         m_margin <= s_margin;
       end
-      OFFS: a <= a - off_r;
       BACK: if (cnt != 0) begin
         t <= t_step;
         cnt <= cnt - 1'b1;
@@ -194,7 +193,7 @@ module tof_distance #(
         end else if (t[TW-1]) begin
           no_tx <= 1'b1;  // code j's burst would precede the first one: never sent
         end else if (tof_w[DW-1]) begin
-          if (t_step[TW-1]) no_tx <= 1'b1;
+          if (t_step_neg) no_tx <= 1'b1;
           else t <= t_step;
         end else begin
           sat <= |tof_w[DW-1:TOF_W];
