@@ -97,7 +97,9 @@
 //   flattened with m_corr / m_chip unconnected (as in the system), then
 //   nextpnr-ice40 --up5k --pack-only:
 //     2 SB_MAC16, 20 SB_RAM40_4K, 1581 SB_LUT4, 589 DFF, 1770 LCs (1126 LUT-only, 455
-//     LUT+DFF, 134 DFF-only, 89 carry-only).
+//     LUT+DFF, 134 DFF-only, 89 carry-only), before the quantizers' saturation became a
+//     sign-bit test (in the system synthesis, -noflatten: 1564 -> 1492 SB_LUT4 and 532 -> 454
+//     SB_CARRY).
 //   Was 2 / 16 / 1768 / 803, 2227 LCs, with the energy ring and LO tables in DFF/LUT logic,
 //   a separate P accumulator and registers that copied (y, and the Q / F / mix words fanning
 //   out of one LUT to two registers); before that 2 / 13 / 1847 / 1860 (flattened 1815 /

@@ -73,13 +73,15 @@
 // vector reads as zeros until a group has been taken (Q_prev is written as 0 then; so is Q2
 // when no j != best exceeds 0).
 // Resources (yosys 0.23 synth_ice40 -dsp of peak_detector alone with the default parameters of
-// generated/default/rtl/peak_detector.vc, then nextpnr-ice40 --up5k --pack-only): 1636 logic
-// cells (1128 LUT4 only, 251 LUT4+DFF, 188 DFF only, 57 carry only, 11 carry legalisation),
-// 1 SB_MAC16, 3 SB_RAM40_4K (was 2057 LCs before the candidate words moved into the memory).
-// The LUTs are mostly the divider (sources into its 51-bit remainder and divisor, the dQ / sum
-// / den adders and the step), the MAC digit multiplexers and accumulator, the scan comparator,
-// the holdoff test (n - n_cand >= HOLDOFF, compared on HOLDOFF's significant bits only) and
-// the arrival adder.
+// generated/default/rtl/peak_detector.vc, then nextpnr-ice40 --up5k --pack-only): 2035 logic
+// cells (1343 LUT4 only, 312 LUT4+DFF, 249 DFF only, 112 carry only, 19 carry legalisation),
+// 1 SB_MAC16, 3 SB_RAM40_4K. It was 1638 before the timing work for 33 MHz (the running max's
+// two precomputed compares and word register, the carry-select divider step and den adder,
+// the pipelined hold-off test: about 400 cells for 21.9 -> 28-30 MHz of the placed system),
+// and 2057 before the candidate words moved into the memory. The LUTs are mostly the divider
+// (sources into its 51-bit remainder and divisor, the dQ / sum / den adders and the step), the
+// MAC digit multiplexers and accumulator, the scan compares, the hold-off test (n - n_cand >=
+// HOLDOFF, compared on HOLDOFF's significant bits only) and the arrival adder.
 `default_nettype none
 
 module peak_detector #(
@@ -165,12 +167,19 @@ module peak_detector #(
   // selected by the state alone (not by take, which waits on the bank's output handshake); a
   // word that is not taken is never decided on (h_v, h_rv low next clock)
   wire [QW-1:0] cmp_src = (state == S_IDLE) ? head : p_rd;
-  // a > b as two half-width compares side by side (half the carry chain's delay)
+  // a > b (the borrow of b - a) as a carry-select compare: the borrows of the low half and
+  // of both versions of the high half (borrow in or not) come out of three carry chains side
+  // by side and one LUT picks (half the chain; an equality tree after the chain was slower)
   localparam integer QH = QW / 2;
   function gt_split;
     input [QW-1:0] a, b;
+    reg [QH:0]    lo;
+    reg [QW-QH:0] h0, h1;
     begin
-      gt_split = (a[QW-1:QH] > b[QW-1:QH]) || (a[QW-1:QH] == b[QW-1:QH] && a[QH-1:0] > b[QH-1:0]);
+      lo = {1'b0, b[QH-1:0]} - {1'b0, a[QH-1:0]};
+      h0 = {1'b0, b[QW-1:QH]} - {1'b0, a[QW-1:QH]};
+      h1 = {1'b0, b[QW-1:QH]} + {1'b1, ~a[QW-1:QH]};       // b - a - 1
+      gt_split = lo[QH] ? h1[QW-QH] : h0[QW-QH];
     end
   endfunction
   wire gt_best = (pend_r && won_r) ? cb_r : ca_r;   // word k > max of the words before it
@@ -293,23 +302,16 @@ module peak_detector #(
   reg            ev_neg;
   reg [FR_W-1:0] fmag;
   reg [SCORE_W-1:0] sc1;
+  // Non-restoring division step: the partial remainder r = {dv_rn, dv_r} is signed (W+1 bits,
+  // in [-d, d)); the next one is 2r + bit - d when r >= 0 and 2r + bit + d when r < 0, chosen by
+  // the register dv_rn (so the XOR is before the carry chain and nothing fans out after it).
+  // The quotient bit is "the next remainder >= 0": the same bits as restoring division (a
+  // negative r is the restoring remainder minus d), which the tests compare with the model.
+  reg          dv_rn;
   wire [W:0]   dv_sh  = {dv_r, dv_q[KM-1]};
-  // dv_sh - dv_d as a carry-select subtractor in three segments: the low segment and both
-  // versions (borrow in or not) of the middle and top segments side by side, then the borrows
-  // pick them (a third of the carry chain)
-  localparam integer DS = (W + 3) / 3;                 // low and middle segment bits
-  localparam integer DT = W + 1 - 2 * DS;              // top segment bits of dv_sh
-  wire [W+1:0] sh_x = {1'b0, dv_sh};
-  wire [W+1:0] d_x  = {2'b00, dv_d};
-  wire [DS:0]  sub_lo  = {1'b0, sh_x[DS-1:0]} - {1'b0, d_x[DS-1:0]};
-  wire [DS:0]  sub_mi0 = {1'b0, sh_x[2*DS-1:DS]} - {1'b0, d_x[2*DS-1:DS]};
-  wire [DS:0]  sub_mi1 = {1'b0, sh_x[2*DS-1:DS]} + {1'b1, ~d_x[2*DS-1:DS]};   // - 1
-  wire [DT:0]  sub_hi0 = sh_x[W+1:2*DS] - d_x[W+1:2*DS];
-  wire [DT:0]  sub_hi1 = sh_x[W+1:2*DS] + ~d_x[W+1:2*DS];                      // - 1
-  wire         b_mi    = sub_lo[DS] ? sub_mi1[DS] : sub_mi0[DS];               // borrow out
-  wire [W+1:0] dv_sub  = {b_mi ? sub_hi1 : sub_hi0,
-                          sub_lo[DS] ? sub_mi1[DS-1:0] : sub_mi0[DS-1:0], sub_lo[DS-1:0]};
-  wire dv_ge = !dv_sub[W+1];
+  wire [W+1:0] dv_sx  = {dv_rn, dv_sh};
+  wire [W+1:0] dv_nx  = dv_sx + ({2'b00, dv_d} ^ {(W+2){~dv_rn}}) + {{(W+1){1'b0}}, ~dv_rn};
+  wire dv_ge = !dv_nx[W];   // the next remainder fits W+1 bits: bit W is its sign
   // den = 4 Q - 2 (Q_prev + Q_next) (S_P2, mod 2^W) as a two-segment carry-select subtractor
   localparam integer EH = W / 2;
   wire [W-1:0]    den_a  = {{(W-QW){1'b0}}, p_rd} << 2;
@@ -546,12 +548,14 @@ module peak_detector #(
       S_P2: begin
         dv_d <= den_cs;
         dv_q <= {KM{1'b0}};
+        dv_rn <= 1'b0;
         dv_cnt <= {CW{1'b0}};
         dsel <= 2'd0;
         fmag <= {FR_W{1'b0}};
       end
       S_DIV: begin
-        dv_r <= dv_ge ? dv_sub[W-1:0] : dv_sh[W-1:0];
+        dv_r <= dv_nx[W-1:0];
+        dv_rn <= dv_nx[W];
         dv_q <= {dv_q[KM-2:0], dv_ge};
         dv_cnt <= dv_cnt + 1'b1;
       end
@@ -564,11 +568,13 @@ module peak_detector #(
             fmag <= dv_q[KF1] ? HALF : fq;
           dsel <= 2'd1;
           dv_r <= {{(W-QW-1){1'b0}}, q_hi};
+          dv_rn <= 1'b0;
           dv_q <= q_lo;
         end else if (dsel == 2'd1) begin
           sc1 <= score_now;
           dsel <= 2'd2;
           dv_r <= {{(W-QW-1){1'b0}}, q_hi};
+          dv_rn <= 1'b0;
           dv_q <= q_lo;
         end
       end

@@ -101,6 +101,11 @@ module tof_distance #(
   reg [CODE_W-1:0] last_code;
 
   reg signed [AW-1:0] a;      // A = arrival - offset
+  // A in two clocks (half the carry chain each): IDLE subtracts the low AL bits and keeps the
+  // borrow and the offset's high part, BACK's first clock (a_fix) the high part
+  localparam integer AL = AW / 2;
+  reg           a_fix, a_b;
+  reg [AW-AL-1:0] off_hi;
   reg signed [TW-1:0] t;      // candidate burst start
   reg [CNT_W-1:0] cnt;        // BACK: periods left to step back; MUL: steps done
   reg no_tx, sat;
@@ -127,6 +132,9 @@ module tof_distance #(
   wire [CODES*OFF_W-1:0] offsets = OFFSETS;
   wire [CODE_W-1:0] j0 = s_code - 1'b1;
   wire signed [OFF_W-1:0] off = (s_code >= 1 && s_code <= CODES) ? offsets[j0 * OFF_W +: OFF_W] : {OFF_W{1'b0}};
+  wire signed [AW-1:0] arr_x = $signed(s_arrival);
+  wire signed [AW-1:0] off_x = off;
+  wire [AL:0] a_lo = {1'b0, arr_x[AL-1:0]} - {1'b0, off_x[AL-1:0]};
   wire signed [KW:0] diff = $signed({2'b00, last_code}) - $signed({2'b00, s_code});
   wire signed [KW:0] k0 = diff < 0 ? diff + CODES : diff;
 
@@ -173,7 +181,10 @@ module tof_distance #(
   always @(posedge clk) begin
     case (state)
       IDLE: begin
-        a <= $signed(s_arrival) - off;  // s_code is a register: the lookup is one LUT level
+        a <= {arr_x[AW-1:AL], a_lo[AL-1:0]};   // s_code is a register: one LUT level
+        a_b <= a_lo[AL];
+        off_hi <= off_x[AW-1:AL];
+        a_fix <= 1'b1;
         t <= $signed({2'b00, last_time});
         cnt <= k0;
         no_tx <= !have_burst;
@@ -182,9 +193,13 @@ module tof_distance #(
         m_score <= s_score;
         m_margin <= s_margin;
       end
-      BACK: if (cnt != 0) begin
-        t <= t_step;
-        cnt <= cnt - 1'b1;
+      BACK: begin
+        if (a_fix) a[AW-1:AL] <= a[AW-1:AL] - off_hi - {{(AW-AL-1){1'b0}}, a_b};
+        a_fix <= 1'b0;
+        if (cnt != 0) begin
+          t <= t_step;
+          cnt <= cnt - 1'b1;
+        end
       end
       TOF: begin
         if (no_tx) begin

@@ -22,8 +22,11 @@
 //            and carries code (b mod CODES) + 1. The drive of sample k is on
 //            hb_p/hb_n from the clock after tick k until the clock after tick
 //            k+1 (registered outputs, no glitches).
-//            burst_valid pulses for one clock with the tick that starts a
-//            burst, with burst_code (1-based) and burst_time = k.
+//            burst_valid is high in the clock of the tick that starts a
+//            burst (combinational from the tick), with burst_code (1-based)
+//            and burst_time = k: the live code index and sample counter, so
+//            there is no registered copy of them (the consumer registers what
+//            it keeps).
 //
 // Resources: counters only (no multiplier, no memory): the code bits are a
 //            CODES*CHIPS constant read by a mux.
@@ -48,9 +51,9 @@ module tx_scheduler #(
   input  wire enable,                  // 0: no new burst starts (a running one completes)
   output reg  hb_p, hb_n,              // H-bridge legs: +1 -> (1,0), -1 -> (0,1), idle (0,0)
   output reg  tx_active,
-  output reg  burst_valid,
-  output reg  [CODE_W-1:0] burst_code, // 1-based
-  output reg  [TIME_W-1:0] burst_time  // sample index of the burst's first sample
+  output wire burst_valid,
+  output wire [CODE_W-1:0] burst_code, // 1-based
+  output wire [TIME_W-1:0] burst_time  // sample index of the burst's first sample
 );
   localparam integer BURST = CHIPS * SPC;
   localparam integer PW = $clog2(PERIOD_T + 1);
@@ -91,13 +94,14 @@ module tx_scheduler #(
   // (first_positive, registered above).
   wire start_now = tick && (t == 0) && enable;
   wire [HW:0] ph_step = {1'b0, ph} + 2 * CYC;
+  assign burst_valid = start_now;
+  assign burst_code = code_idx + 1'b1;
+  assign burst_time = n;
 
   always @(posedge clk) begin
-    burst_valid <= 1'b0;
     if (rst) begin
       n <= 0; t <= 0; code_idx <= 0; in_burst <= 1'b0; chip <= 0; s <= 0; ph <= 0;
       hb_p <= 1'b0; hb_n <= 1'b0; tx_active <= 1'b0;
-      burst_code <= 0; burst_time <= 0;
     end else if (tick) begin
       n <= n + 1'b1;
       t <= (t == PERIOD_T - 1) ? {PW{1'b0}} : t + 1'b1;
@@ -107,9 +111,6 @@ module tx_scheduler #(
           // first sample of a burst: chip 0, s 0, ph 0 (use the code of this burst)
           hb_p <= first_positive;
           hb_n <= ~first_positive;
-          burst_valid <= 1'b1;
-          burst_code <= code_idx + 1'b1;
-          burst_time <= n;
         end else begin
           hb_p <= positive;
           hb_n <= ~positive;
