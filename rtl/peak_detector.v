@@ -310,7 +310,20 @@ module peak_detector #(
   reg          dv_rn;
   wire [W:0]   dv_sh  = {dv_r, dv_q[KM-1]};
   wire [W+1:0] dv_sx  = {dv_rn, dv_sh};
-  wire [W+1:0] dv_nx  = dv_sx + ({2'b00, dv_d} ^ {(W+2){~dv_rn}}) + {{(W+1){1'b0}}, ~dv_rn};
+  wire [W+1:0] dv_b   = {2'b00, dv_d} ^ {(W+2){~dv_rn}};
+  // dv_sx + dv_b + ~dv_rn as a carry-select adder in three segments (a third of the chain):
+  // the low segment and both versions (carry in or not) of the middle and top ones side by
+  // side, then the carries pick them
+  localparam integer NS = (W + 4) / 3;                 // low and middle segment bits
+  localparam integer NT = W + 2 - 2 * NS;              // top segment bits
+  wire [NS:0]   nx_lo  = {1'b0, dv_sx[NS-1:0]} + {1'b0, dv_b[NS-1:0]} + {{NS{1'b0}}, ~dv_rn};
+  wire [NS:0]   nx_mi0 = {1'b0, dv_sx[2*NS-1:NS]} + {1'b0, dv_b[2*NS-1:NS]};
+  wire [NS:0]   nx_mi1 = {1'b0, dv_sx[2*NS-1:NS]} + {1'b0, dv_b[2*NS-1:NS]} + 1'b1;
+  wire [NT-1:0] nx_hi0 = dv_sx[W+1:2*NS] + dv_b[W+1:2*NS];
+  wire [NT-1:0] nx_hi1 = dv_sx[W+1:2*NS] + dv_b[W+1:2*NS] + 1'b1;
+  wire          nx_c2  = nx_lo[NS] ? nx_mi1[NS] : nx_mi0[NS];
+  wire [W+1:0]  dv_nx  = {nx_c2 ? nx_hi1 : nx_hi0,
+                          nx_lo[NS] ? nx_mi1[NS-1:0] : nx_mi0[NS-1:0], nx_lo[NS-1:0]};
   wire dv_ge = !dv_nx[W];   // the next remainder fits W+1 bits: bit W is its sign
   // den = 4 Q - 2 (Q_prev + Q_next) (S_P2, mod 2^W) as a two-segment carry-select subtractor
   localparam integer EH = W / 2;
