@@ -34,7 +34,8 @@
 //    a small signed accumulator that is shifted right 16 bits after each column; the bits
 //    shifted out are >= 0 (arithmetic shift = floor), so D = acc 2^(16 cols) + L with
 //    0 <= L < 2^(16 cols): D >= 0 <=> acc >= 0 and D > 0 <=> acc > 0 || (acc == 0 && L != 0).
-//  - One restoring divider with only the quotient bits that can survive the cap / clamp:
+//  - One divider (non-restoring steps: the quotient bits of restoring division, see the
+//    datapath) with only the quotient bits that can survive the cap / clamp:
 //    score: start with R = Q >> (SCORE_W+1) and run SCORE_W+1 steps over Q[SCORE_W:0]. The
 //      first step compares Q >> SCORE_W with norm1: if >=, floor(Q/norm1) >= 2^SCORE_W and the
 //      score is the cap (later bits are ignored); else Q >> SCORE_W < norm1 is a valid restoring

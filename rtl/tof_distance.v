@@ -31,9 +31,10 @@
 //            Flags: bit 0 no burst of code j before the arrival (ToF and
 //            distance 0), bit 1 ToF or distance saturated.
 //
-// Timing:    sequential (no DSP): up to CODES-1 cycles to step back to code j's
-//            burst, 2-3 cycles for the ToF (its subtractor is registered; two
-//            more per cycle stepped back),
+// Timing:    sequential (no DSP): the offset is subtracted over two clocks (low
+//            half at capture, high half in the first step-back cycle), up to
+//            CODES-1 cycles to step back to code j's burst, 2-3 cycles for the
+//            ToF (its subtractor is registered; two more per cycle stepped back),
 //            TOF_W cycles of shift-add (one C_W+1-bit adder) multiply with the
 //            rounding term as its start value, 1 cycle to saturate the distance,
 //            then the result waits on m_ready. s_ready is high only when idle:
