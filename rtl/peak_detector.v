@@ -508,14 +508,12 @@ module peak_detector #(
       h_j <= j;
       h_first <= first;
       h_last <= s_last;
+      nrm <= s_energy[ENERGY_W-1 -: NW];
+      n_r <= s_index;
     end
     if (h_v && (gt_best || h_first)) begin
       best_q <= h_q;
       best <= h_j;
-    end
-    if (take) begin
-      nrm <= s_energy[ENERGY_W-1 -: NW];
-      n_r <= s_index;
     end
     if (state == S_DECIDE) begin
       best_q <= {QW{1'b0}};
