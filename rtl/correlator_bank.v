@@ -42,7 +42,10 @@
 //     FIR (stage A): per output, lane re then lane im, TAPS taps, ceil(DEC_W/16) x
 //       ceil(TAP_W/16) limb products per tap, from the Bd history (TAPS+1 deep, so the next
 //       Bd can be written while a FIR runs) into one FIR_W accumulator; F_re is quantized
-//       while the first im product is accumulated, F_im after the last.
+//       while the first im product is accumulated, F_im after the last. The history is read
+//       one tap ahead: the tap being multiplied is a registered magnitude and sign (no
+//       negation between the memory and the multiplier), which costs one priming clock per
+//       output.
 //     Combiner (no multiplier): per output, one round per code; each round reads the CHIPS
 //       taps F[k - (CHIPS-1-m) CHIP_STEP] from the F history (one per clock) into two
 //       COMB_W accumulators (re, im; C +- F on one adder each), then quantizes them into
@@ -69,7 +72,8 @@
 //     history entry outside the window in use), so yosys need not emulate read-old-data
 //     (it cost a registered copy of the write data and a bypass mux per memory).
 //   Limb products per output at the defaults (DEC_W 23, TAP_W 16, CORR_W 16, TAPS 20,
-//     CODES 9): FIR 2*20*2 = 80, SQ 9*2 = 18, W 9*2 = 18: 116 <= 120 = 6 DECIM clocks.
+//     CODES 9): FIR 2*20*2 = 80 (+ 1 priming clock), SQ 9*2 = 18, W 9*2 = 18: 117 <= 120 = 6
+//     DECIM clocks.
 // Throughput: 6 clocks per input sample when the back end keeps up, i.e. when
 //   2 TAPS ceil(DEC_W/16) ceil(TAP_W/16) + CODES (2 ceil(CORR_W/16)^2 + ceil(2 CORR_W/16)
 //   ceil(WEIGHT_W/16)) <= 6 DECIM (plus a few clocks of pipeline slack); otherwise the back
@@ -100,6 +104,8 @@
 //     LUT+DFF, 134 DFF-only, 89 carry-only), before the quantizers' saturation became a
 //     sign-bit test (in the system synthesis, -noflatten: 1564 -> 1492 SB_LUT4 and 532 -> 454
 //     SB_CARRY).
+//   Then the FIR read-ahead (|Bd| and its sign in 24 DFF) and the combiner's registered chip
+//   sign (timing of the placed system): 1795 LCs standalone with every port connected.
 //   Was 2 / 16 / 1768 / 803, 2227 LCs, with the energy ring and LO tables in DFF/LUT logic,
 //   a separate P accumulator and registers that copied (y, and the Q / F / mix words fanning
 //   out of one LUT to two registers); before that 2 / 13 / 1847 / 1860 (flattened 1815 /
@@ -559,9 +565,10 @@ module correlator_bank #(
   /* verilator lint_on UNUSEDSIGNAL */
 
   // ---- stage A: chip FIR
-  reg             a_busy, a_lane;
+  reg             a_busy, a_lane, a_prime, r_lane;
   reg [BA_W-1:0]  a_base, a_addr;
-  reg [TI_W-1:0]  a_cnt, a_i;
+  reg [TI_W-1:0]  a_cnt, a_i, r_i;
+  wire            a_iss;          // a FIR product issues this clock
   reg [LBA_W-1:0] a_la;
   reg [LTB_W-1:0] a_lb;
   reg [FIR_W-1:0] facc;
@@ -572,21 +579,33 @@ module correlator_bank #(
   wire a_first    = (a_i == {TI_W{1'b0}}) && (a_la == {LBA_W{1'b0}}) && (a_lb == {LTB_W{1'b0}});
   wire a_last     = (a_i == T_LAST) && a_tap_end;
   wire [BA_W-1:0] a_addr_dec = (a_addr == {BA_W{1'b0}}) ? BD_LAST : a_addr - 1'b1;
-  wire signed [DEC_W-1:0] bd_lane = a_lane ? bd_rd[DEC_W-1:0] : bd_rd[2*DEC_W-1:DEC_W];
-  wire [DEC_W-1:0] bd_mag = bd_lane[DEC_W-1] ? -bd_lane : bd_lane;
-  wire [NBA*LW-1:0] bd_mag_p = {{(NBA*LW-DEC_W){1'b0}}, bd_mag};
+  // The FIR reads one tap ahead: bd_rd holds the word of the tap after the one being
+  // multiplied (a_addr, index r_i in lane r_lane), and the magnitude and sign of the tap being
+  // multiplied are registers (bd_mag_r, bd_sgn_r), loaded from bd_rd when that tap's last
+  // product issues (and once at the start, a_prime). So no negation sits between the memory
+  // read and the multiplier's operand; the FIR costs one priming clock per output.
+  wire a_adv = a_iss && a_tap_end;
+  wire signed [DEC_W-1:0] bd_lane = r_lane ? bd_rd[DEC_W-1:0] : bd_rd[2*DEC_W-1:DEC_W];
+  reg  [DEC_W-1:0] bd_mag_r;
+  reg              bd_sgn_r;
+  always @(posedge clk)
+    if (a_prime || a_adv) begin
+      bd_mag_r <= bd_lane[DEC_W-1] ? -bd_lane : bd_lane;
+      bd_sgn_r <= bd_lane[DEC_W-1];
+    end
+  wire [NBA*LW-1:0] bd_mag_p = {{(NBA*LW-DEC_W){1'b0}}, bd_mag_r};
   wire a_ok = (a_i < a_cnt);  // Bd entry written since reset (else it reads as zero)
   wire [LW-1:0] a_opa = a_ok ? bd_mag_p[a_la*LW +: LW] : {LW{1'b0}};
   wire [TAPM_W:0] tap_sm = tap_rom(a_i);
   wire [TAPM_W-1:0] tap_mag = tap_sm[TAPM_W-1:0];
   wire [LW-1:0] a_opb = tap_mag[a_lb*LW +: LW];
-  wire a_neg = a_ok && (bd_lane[DEC_W-1] ^ tap_sm[TAPM_W]);
+  wire a_neg = a_ok && (bd_sgn_r ^ tap_sm[TAPM_W]);
 
   // ---- combiner
   localparam [1:0] C_IDLE = 2'd0, C_RUN = 2'd1, C_DRAIN = 2'd2, C_Q = 2'd3;
   reg [1:0]        c_state;
-  reg [CI_W-1:0]   c_m, c_m1;
-  reg              c_iss1, c_dv1;
+  reg [CI_W-1:0]   c_m;
+  reg              c_iss1, c_dv1, c_neg;   // c_neg: chip c_m of code c_j is -1, a clock later
   reg [JI_W-1:0]   c_j;
   reg [FA_W-1:0]   f_wptr, f_rptr, f_old;
   reg [DIST_W-1:0] f_cnt, f_dist;
@@ -605,7 +624,6 @@ module correlator_bank #(
   wire signed [CA_W-1:0] f_im_x = {{(CA_W-CHIP_W){f_rd_im[CHIP_W-1]}}, f_rd_im};
   // C += s F as one adder: C + (F ^ -neg) + neg, the carry-in entering as a low bit;
   // an entry not written since reset reads as zero.
-  wire c_neg = !code_rom(c_j, c_m1);
   wire [CA_W-1:0] f_re_m = (c_dv1 ? f_re_x : {CA_W{1'b0}}) ^ {CA_W{c_neg}};
   wire [CA_W-1:0] f_im_m = (c_dv1 ? f_im_x : {CA_W{1'b0}}) ^ {CA_W{c_neg}};
   /* verilator lint_off UNUSEDSIGNAL */
@@ -649,7 +667,7 @@ module correlator_bank #(
   wire w_iss  = pw_valid;
   wire sq_iss = !pw_valid && cq_valid && (!sq_first || sq_idle);
   // F_re is written 2 clocks after the last re product issues: only when fres is free.
-  wire a_iss  = !w_iss && !sq_iss && a_busy && !(!a_lane && a_last && fres_valid);
+  assign a_iss = !w_iss && !sq_iss && a_busy && !a_prime && !(!a_lane && a_last && fres_valid);
 
   // ---- output: ping-pong group buffer (2 banks x 2^JI_W codes) of Q_j and {Cq_re, Cq_im}_j
   // in synchronous-read memories; the back end writes bank wr_bank, the consumer reads beat
@@ -683,7 +701,7 @@ module correlator_bank #(
   // FIR read address: the Bd entry of the op presented next clock.
   always @(*) begin
     if (a_start) a_addr_nx = bd_wptr;
-    else if (a_iss && a_tap_end) a_addr_nx = (a_i == T_LAST) ? a_base : a_addr_dec;
+    else if (a_prime || a_adv) a_addr_nx = (r_i == T_LAST) ? a_base : a_addr_dec;
     else a_addr_nx = a_addr;
   end
 
@@ -706,10 +724,11 @@ module correlator_bank #(
       s1_first <= 1'b0; s2_first <= 1'b0; s1_last <= 1'b0; s2_last <= 1'b0;
       s1_neg <= 1'b0; s2_neg <= 1'b0; s1_lane <= 1'b0; s2_lane <= 1'b0;
       s1_sh <= 0; s2_sh <= 0; s1_j <= 0; s2_j <= 0;
-      a_busy <= 1'b0; a_lane <= 1'b0; a_base <= 0; a_addr <= 0; a_cnt <= 0; a_i <= 0;
+      a_busy <= 1'b0; a_lane <= 1'b0; a_prime <= 1'b0; a_base <= 0; a_addr <= 0; a_cnt <= 0;
+      a_i <= 0; r_i <= 0; r_lane <= 1'b0;
       a_la <= 0; a_lb <= 0; fq_pend <= 1'b0; fq_lane <= 1'b0;
       fres_valid <= 1'b0;
-      c_state <= C_IDLE; c_m <= 0; c_m1 <= 0; c_iss1 <= 1'b0; c_dv1 <= 1'b0;
+      c_state <= C_IDLE; c_m <= 0; c_neg <= 1'b0; c_iss1 <= 1'b0; c_dv1 <= 1'b0;
       c_j <= 0; f_wptr <= F_LAST; f_rptr <= 0; f_old <= 0; f_cnt <= 0; f_dist <= 0;
       ca_re <= 0; ca_im <= 0;
       cq_valid <= 1'b0;
@@ -725,6 +744,14 @@ module correlator_bank #(
       if (b_done && !g_taken) g_full <= g_full + 1'b1;
       else if (g_taken && !b_done) g_full <= g_full - 1'b1;
       a_addr <= a_addr_nx;
+      a_prime <= a_start;
+      if (a_start) begin
+        r_i <= 0;
+        r_lane <= 1'b0;
+      end else if (a_prime || a_adv) begin
+        r_i <= (r_i == T_LAST) ? {TI_W{1'b0}} : r_i + 1'b1;
+        if (r_i == T_LAST) r_lane <= !r_lane;
+      end
 
       // ---------------- issue (one limb product per clock)
       s1_v <= w_iss || sq_iss || a_iss;
@@ -834,7 +861,7 @@ module correlator_bank #(
       case (c_state)
         C_RUN: begin
           c_iss1 <= 1'b1;
-          c_m1 <= c_m;
+          c_neg <= !code_rom(c_j, c_m);   // c_j does not change before the chip is added
           c_dv1 <= (f_dist < f_cnt);
           f_rptr <= (f_rptr_step >= FN_A) ? f_rptr_wrap[FA_W-1:0] : f_rptr_step[FA_W-1:0];
           f_dist <= f_dist - STEP_D;

@@ -46,15 +46,19 @@
 //      else R < den holds and the remaining FRAC_W-1 steps give floor(X/den) < HALF exactly.
 //      The sign is applied afterwards (trunc toward zero = sign * floor(|X|/den)); den <= 0
 //      gives 0. Both rules equal the model's floor + min(cap) / trunc + clamp for every input.
+//    The steps run on one adder of DA = max(WEIGHTED_W-SCORE_W+1, norm bits+2, (W+3)/2) bits
+//    (33 at the defaults): a score step in one clock, a fraction step in two (low half, its
+//    carry registered, then high half), so no carry chain is longer than DA.
 //  - |dQ| = |Q_next - Q_prev| uses one subtractor twice (Q_prev - Q_next, then Q_next -
-//    Q_prev if that was negative: no negation adder), then Q_prev + Q_next and den = 4Q -
-//    2(Q_prev + Q_next), one adder each per clock, in the divider's registers.
+//    Q_prev if that was negative: no negation adder; carry-select), then Q_prev + Q_next (in
+//    two clocks, half the chain each) and den = 4Q - 2(Q_prev + Q_next) (carry-select), in the
+//    divider's registers.
 //  - Output: the event is presented in S_OUT straight from the registers that computed it
 //    (code from the candidate, score from sc1, margin = sc1 - second score on one 16-bit
 //    subtractor, arrival = n 2^FRAC_W + DECIM frac written into the divisor register dv_d in the
 //    last divider step); the detector stays in S_OUT (s_ready low) until m_ready.
 // Bit growth: MAC accumulator 36 + clog2(NA+NB) bits signed (sum of <= 2 min(NA,NB) products
-// of 32 bits plus the carried-in column); divider registers max(WEIGHTED_W+3, norm bits+1,
+// of 32 bits plus the carried-in column); divider registers max(WEIGHTED_W+3, norm bits+1, DA+1,
 // arrival bits+1); DECIM * frac in FRAC_W+2+clog2(DECIM+1) bits; quotients as above. No
 // rounding; nothing can overflow.
 // Latency / throughput (CODES=9, 48-bit Q, 29-bit norm: NA=3, NB=2 digits): a group takes
@@ -62,9 +66,9 @@
 // each beat a clock after taking it) + (2 NA NB + 3) [gate] +
 // (2 NA NB + 3) [rho^2 test, only when the gate passes and a candidate exists] + 1, plus
 // CODES + 1 + 4 on a capture (re-read, copies) or 2 when Q_next is copied; an event adds
-// 5 + FRAC_W + 1 + 2 (SCORE_W + 2) + 1 = 51 clocks (events and captures exclude each other),
-// so a group is done in <= 91 clocks after its first beat (measured by tb_peak_detector: 91 on
-// the edge-case stream, 76 on the paced coded stream) < the 120 between the bank's groups
+// 6 + 2 FRAC_W + 1 + 2 (SCORE_W + 2) + 1 = 60 clocks (events and captures exclude each other),
+// so a group is done in <= 101 clocks after its first beat (measured by tb_peak_detector: 101
+// on the edge-case stream, 86 on the paced coded stream) < the 120 between the bank's groups
 // (DECIM 20 x 6 clocks): s_ready is high whenever the bank starts a group and stays high for
 // its CODES beats. s_ready is low while a group's tests or an event are processed and while the
 // event waits for m_ready (back-pressure stalls the bank; nothing is lost).
@@ -74,13 +78,14 @@
 // vector reads as zeros until a group has been taken (Q_prev is written as 0 then; so is Q2
 // when no j != best exceeds 0).
 // Resources (yosys 0.23 synth_ice40 -dsp of peak_detector alone with the default parameters of
-// generated/default/rtl/peak_detector.vc, then nextpnr-ice40 --up5k --pack-only): 2035 logic
-// cells (1343 LUT4 only, 312 LUT4+DFF, 249 DFF only, 112 carry only, 19 carry legalisation),
-// 1 SB_MAC16, 3 SB_RAM40_4K. It was 1638 before the timing work for 33 MHz (the running max's
-// two precomputed compares and word register, the carry-select divider step and den adder,
-// the pipelined hold-off test: about 400 cells for 21.9 -> 28-30 MHz of the placed system),
-// and 2057 before the candidate words moved into the memory. The LUTs are mostly the divider
-// (sources into its 51-bit remainder and divisor, the dQ / sum / den adders and the step), the
+// generated/default/rtl/peak_detector.vc, then nextpnr-ice40 --up5k --pack-only): 1854 logic
+// cells (1109 LUT4 only, 362 LUT4+DFF, 205 DFF only, 156 carry only, 22 carry legalisation),
+// 1 SB_MAC16, 3 SB_RAM40_4K. It was 2035 with a full-width (53-bit, three-segment
+// carry-select) division step, 1638 before the timing work for 33 MHz (the running max's
+// two precomputed compares and word register, the carry-select step and den adder, the
+// pipelined hold-off test), and 2057 before the candidate words moved into the memory. The
+// LUTs are mostly the divider (sources into its 51-bit remainder and divisor, the dQ / sum /
+// den adders and the step adder's operand multiplexers), the
 // MAC digit multiplexers and accumulator, the scan compares, the hold-off test (n - n_cand >=
 // HOLDOFF, compared on HOLDOFF's significant bits only) and the arrival adder.
 `default_nettype none
@@ -117,7 +122,12 @@ module peak_detector #(
   localparam integer AW    = 36 + $clog2(NA + NB);                // MAC accumulator
   localparam integer ARR_W = TIME_W + FRAC_W + 1;
   localparam integer W0    = (QW + 3 > NW + 1) ? QW + 3 : NW + 1;
-  localparam integer W     = (W0 > ARR_W) ? W0 : ARR_W + 1;       // divider registers (and arrival)
+  localparam integer W1    = (W0 > ARR_W) ? W0 : ARR_W + 1;
+  // the division step adder (see the datapath): the score steps' range, and half the
+  // fraction's W+2 bits
+  localparam integer DA0   = (QW - SCORE_W + 1 > NW + 2) ? QW - SCORE_W + 1 : NW + 2;
+  localparam integer DA    = (DA0 > (W1 + 3) / 2) ? DA0 : (W1 + 3) / 2;
+  localparam integer W     = (W1 > DA) ? W1 : DA + 1;             // divider registers (and arrival)
   localparam integer KM    = (SCORE_W + 1 > FRAC_W) ? SCORE_W + 1 : FRAC_W;  // quotient bits
   localparam integer CW    = $clog2(KM + 1);
   localparam integer FR_W  = FRAC_W + 2;                          // signed fraction
@@ -138,7 +148,7 @@ module peak_detector #(
   localparam integer AB    = (JB > 2) ? JB : 2;                   // memory index bits
   localparam [3:0] S_IDLE = 4'd0, S_MAC = 4'd2, S_DECIDE = 4'd3,
                    S_P0 = 4'd4, S_P1 = 4'd5, S_DIV = 4'd6, S_NEXT = 4'd7, S_OUT = 4'd8,
-                   S_CP = 4'd9, S_EA = 4'd10, S_EB = 4'd11, S_P2 = 4'd12, S_R2 = 4'd13;
+                   S_CP = 4'd9, S_EA = 4'd10, S_EB = 4'd11, S_P2 = 4'd12, S_R2 = 4'd13, S_PS = 4'd14;
   reg [3:0] state;
 
   // ---------------------------------------------------------------- input beats and scan
@@ -217,14 +227,14 @@ module peak_detector #(
             else if (cp == 2'd1) raddr = {1'b0, ~par, best_x[AB-1:0]};
             else            raddr = {1'b0, ~par, sidx_x[AB-1:0]};
       S_R2: raddr = {1'b0, ~par, j_x[AB-1:0]};
-      S_EA, S_P0: raddr = C_QN;
+      S_EA, S_P0, S_P1: raddr = C_QN;
       S_EB: raddr = C_QP;
       S_DIV, S_NEXT: raddr = C_Q2;
       default: ;
     endcase
   end
   wire re = (state == S_MAC) || (state == S_R2) || (state == S_CP) || (state == S_EA) || (state == S_EB) ||
-            (state == S_P0) || (state == S_P1) || (dsel != 2'd0 && (state == S_DIV || state == S_NEXT));
+            (state == S_P0) || (state == S_P1) || (state == S_PS) || (dsel != 2'd0 && (state == S_DIV || state == S_NEXT));
   wire cp_we = (state == S_CP) && cp != 2'd0;
   wire [AB+1:0] waddr = take ? {1'b0, par, j_x[AB-1:0]}
                              : {2'b10, {(AB-2){1'b0}}, cp_kind ? cp - 1'b1 : 2'd3};
@@ -308,24 +318,29 @@ module peak_detector #(
   // the register dv_rn (so the XOR is before the carry chain and nothing fans out after it).
   // The quotient bit is "the next remainder >= 0": the same bits as restoring division (a
   // negative r is the restoring remainder minus d), which the tests compare with the model.
-  reg          dv_rn;
-  wire [W:0]   dv_sh  = {dv_r, dv_q[KM-1]};
-  wire [W+1:0] dv_sx  = {dv_rn, dv_sh};
-  wire [W+1:0] dv_b   = {2'b00, dv_d} ^ {(W+2){~dv_rn}};
-  // dv_sx + dv_b + ~dv_rn as a carry-select adder in three segments (a third of the chain):
-  // the low segment and both versions (carry in or not) of the middle and top ones side by
-  // side, then the carries pick them
-  localparam integer NS = (W + 4) / 3;                 // low and middle segment bits
-  localparam integer NT = W + 2 - 2 * NS;              // top segment bits
-  wire [NS:0]   nx_lo  = {1'b0, dv_sx[NS-1:0]} + {1'b0, dv_b[NS-1:0]} + {{NS{1'b0}}, ~dv_rn};
-  wire [NS:0]   nx_mi0 = {1'b0, dv_sx[2*NS-1:NS]} + {1'b0, dv_b[2*NS-1:NS]};
-  wire [NS:0]   nx_mi1 = {1'b0, dv_sx[2*NS-1:NS]} + {1'b0, dv_b[2*NS-1:NS]} + 1'b1;
-  wire [NT-1:0] nx_hi0 = dv_sx[W+1:2*NS] + dv_b[W+1:2*NS];
-  wire [NT-1:0] nx_hi1 = dv_sx[W+1:2*NS] + dv_b[W+1:2*NS] + 1'b1;
-  wire          nx_c2  = nx_lo[NS] ? nx_mi1[NS] : nx_mi0[NS];
-  wire [W+1:0]  dv_nx  = {nx_c2 ? nx_hi1 : nx_hi0,
-                          nx_lo[NS] ? nx_mi1[NS-1:0] : nx_mi0[NS-1:0], nx_lo[NS-1:0]};
-  wire dv_ge = !dv_nx[W];   // the next remainder fits W+1 bits: bit W is its sign
+  // One DA-bit adder does the steps (a third of the carry cells of a full-width carry-select
+  // step and a chain of DA instead of W+2 bits):
+  //   score (dsel 1, 2): one clock per step, on the low DA bits. In range, r is in [-norm1,
+  //     norm1) and 2r + bit +- norm1 fits NW+2 signed bits; the first step's 2R + bit - norm1
+  //     (R = Q >> (SCORE_W+1) < 2^(QW-SCORE_W-1)) fits QW-SCORE_W+1. After a first quotient bit
+  //     1 the score is the cap and the later (possibly wrapped) bits are not used.
+  //   fraction (dsel 0): two clocks per step (dv_ph): the low DA bits, their carry registered
+  //     (dv_cl), then the high W+2-DA bits; dv_rn (the step's add / subtract) changes only after
+  //     the high pass, and dv_rm keeps r[DA-1] (bit DA of 2r) that the low pass overwrote.
+  reg          dv_rn, dv_ph, dv_cl, dv_rm;
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [DA+W+1:0] dv_sw = {{DA{dv_rn}}, dv_rn, dv_r, dv_q[KM-1]};   // 2r + bit, sign-extended
+  wire [2*DA-1:0] dv_dw = {{(2*DA-W){1'b0}}, dv_d};
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire [DA-1:0] st_a  = dv_ph ? {dv_sw[2*DA-1:DA+1], dv_rm} : dv_sw[DA-1:0];
+  wire [DA-1:0] st_b  = (dv_ph ? dv_dw[2*DA-1:DA] : dv_dw[DA-1:0]) ^ {DA{~dv_rn}};
+  wire          st_ci = dv_ph ? dv_cl : ~dv_rn;
+  wire [DA:0]   st    = {1'b0, st_a} + {1'b0, st_b} + {{DA{1'b0}}, st_ci};
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [2*DA-1:0] st_hi = {st[DA-1:0], dv_r[DA-1:0]};   // after the high pass: r' = st_hi[W-1:0]
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire dv_sgn = dv_ph ? st_hi[W] : st[DA-1];   // the sign of the step's result
+  wire dv_last = dv_ph || (dsel != 2'd0);      // the step's last clock
   // den = 4 Q - 2 (Q_prev + Q_next) (S_P2, mod 2^W) as a two-segment carry-select subtractor
   localparam integer EH = W / 2;
   wire [W-1:0]    den_a  = {{(W-QW){1'b0}}, p_rd} << 2;
@@ -334,6 +349,18 @@ module peak_detector #(
   wire [W-EH-1:0] den_h0 = den_a[W-1:EH] - den_b[W-1:EH];
   wire [W-EH-1:0] den_h1 = den_a[W-1:EH] + ~den_b[W-1:EH];   // - 1
   wire [W-1:0]    den_cs = {den_lo[EH] ? den_h1 : den_h0, den_lo[EH-1:0]};
+  // p_rd - dv_d on QW-bit operands (S_P0, S_P1: Q_prev - Q_next, Q_next - Q_prev), sign-extended
+  // to W, as a two-segment carry-select subtractor (the low half's borrow picks the high half)
+  localparam integer SB = (QW + 1) / 2;
+  wire [SB:0]    sb_lo = {1'b0, p_rd[SB-1:0]} - {1'b0, dv_d[SB-1:0]};
+  wire [QW-SB:0] sb_h0 = {1'b0, p_rd[QW-1:SB]} - {1'b0, dv_d[QW-1:SB]};
+  wire [QW-SB:0] sb_h1 = {1'b0, p_rd[QW-1:SB]} + ~{1'b0, dv_d[QW-1:SB]};   // - 1
+  wire [QW-SB:0] sb_hi = sb_lo[SB] ? sb_h1 : sb_h0;
+  wire [W-1:0]   dq_sub = {{(W-QW-1){sb_hi[QW-SB]}}, sb_hi, sb_lo[SB-1:0]};
+  // Q_prev + Q_next over two clocks (S_P1 the low SB bits and the carry ps_c, S_PS the rest)
+  reg            ps_c;
+  wire [SB:0]    ps_lo = {1'b0, p_rd[SB-1:0]} + {1'b0, dv_d[SB-1:0]};
+  wire [W-SB-1:0] ps_hi = {{(W-QW){1'b0}}, p_rd[QW-1:SB]} + dv_d[W-1:SB] + {{(W-SB-1){1'b0}}, ps_c};
   wire [CW-1:0] dv_k = (dsel == 2'd0) ? KF : KS;
   wire [SCORE_W-1:0] score_now = dv_q[SCORE_W] ? CAP : dv_q[SCORE_W-1:0];
   // quotient of the fraction division: its low FRAC_W bits (< HALF when the top one is 0)
@@ -460,9 +487,10 @@ module peak_detector #(
         S_EA: state <= S_EB;
         S_EB: state <= S_P0;
         S_P0: state <= S_P1;
-        S_P1: state <= S_P2;
+        S_P1: state <= S_PS;
+        S_PS: state <= S_P2;
         S_P2: state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
-        S_DIV: if (dv_cnt + 1'b1 == dv_k) state <= S_NEXT;
+        S_DIV: if (dv_last && dv_cnt + 1'b1 == dv_k) state <= S_NEXT;
         S_NEXT: state <= (dsel == 2'd2) ? S_OUT : S_DIV;
         S_OUT: if (m_ready) state <= S_IDLE;
         default: state <= S_IDLE;
@@ -548,28 +576,39 @@ module peak_detector #(
       // twice, no negation: Q_prev - Q_next, and Q_next - Q_prev if that was negative
       S_EB: dv_d <= {{(W-QW){1'b0}}, p_rd};     // Q_next
       S_P0: begin                               // p_rd = Q_prev
-        dv_r <= {{(W-QW){1'b0}}, p_rd} - dv_d;
+        dv_r <= dq_sub;
         dv_d <= {{(W-QW){1'b0}}, p_rd};
       end
       S_P1: begin                               // p_rd = Q_next; dQ = 0 gives frac 0 either way
         ev_neg <= !dv_r[W-1];
-        if (dv_r[W-1]) dv_r <= {{(W-QW){1'b0}}, p_rd} - dv_d;
-        dv_d <= {{(W-QW){1'b0}}, p_rd} + dv_d;
+        if (dv_r[W-1]) dv_r <= dq_sub;
+        dv_d[SB-1:0] <= ps_lo[SB-1:0];
+        ps_c <= ps_lo[SB];
       end
+      S_PS: dv_d[W-1:SB] <= ps_hi;              // p_rd = Q_next again
       // den = 4Q - 2(Q_prev + Q_next)
       S_P2: begin
         dv_d <= den_cs;
         dv_q <= {KM{1'b0}};
         dv_rn <= 1'b0;
+        dv_ph <= 1'b0;
         dv_cnt <= {CW{1'b0}};
         dsel <= 2'd0;
         fmag <= {FR_W{1'b0}};
       end
       S_DIV: begin
-        dv_r <= dv_nx[W-1:0];
-        dv_rn <= dv_nx[W];
-        dv_q <= {dv_q[KM-2:0], dv_ge};
-        dv_cnt <= dv_cnt + 1'b1;
+        if (dv_ph) dv_r <= st_hi[W-1:0];
+        else begin
+          dv_r[DA-1:0] <= st[DA-1:0];
+          dv_rm <= dv_r[DA-1];
+          dv_cl <= st[DA];
+        end
+        if (dsel == 2'd0) dv_ph <= ~dv_ph;
+        if (dv_last) begin
+          dv_rn <= dv_sgn;
+          dv_q <= {dv_q[KM-2:0], !dv_sgn};
+          dv_cnt <= dv_cnt + 1'b1;
+        end
       end
       S_NEXT: begin
         dv_cnt <= {CW{1'b0}};

@@ -417,12 +417,13 @@ TEST(CorrelatorBankRtl, BitExactOnCodedBurstsAndWorstCase) {
 // bank must accept every sample on the clock it is presented (never stall the stream) and
 // still match the model on every output, both with the output always taken and with a
 // consumer like the peak detector: it takes the beats of a group one per clock, then is busy
-// (m_ready low) for kBusy clocks after each group's last beat (~100 clocks per group).
+// (m_ready low) for kBusy clocks after each group's last beat (~110 clocks per group; 101 is
+// the detector's worst group, with an event, measured by tb_peak_detector).
 TEST(CorrelatorBankRtl, SustainsOneSampleEverySixClocks) {
   const auto& d = design();
   ASSERT_EQ(d.layout.decimation, 20) << "the throughput target is for the default configuration";
   constexpr int kClocksPerSample = 6;
-  constexpr int kBusy = 91;
+  constexpr int kBusy = 101;
   std::vector<std::int64_t> y;
   for (std::size_t j : {0u, 4u, 8u}) {  // three coded bursts back to back
     std::size_t arrival = 0;
