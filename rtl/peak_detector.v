@@ -148,7 +148,7 @@ module peak_detector #(
   localparam integer AB    = (JB > 2) ? JB : 2;                   // memory index bits
   localparam [3:0] S_IDLE = 4'd0, S_MAC = 4'd2, S_DECIDE = 4'd3,
                    S_P0 = 4'd4, S_P1 = 4'd5, S_DIV = 4'd6, S_NEXT = 4'd7, S_OUT = 4'd8,
-                   S_CP = 4'd9, S_EA = 4'd10, S_EB = 4'd11, S_P2 = 4'd12, S_R2 = 4'd13, S_PS = 4'd14, S_P3 = 4'd1;
+                   S_CP = 4'd9, S_EA = 4'd10, S_EB = 4'd11, S_P2 = 4'd12, S_R2 = 4'd13, S_PS = 4'd14;
   reg [3:0] state;
 
   // ---------------------------------------------------------------- input beats and scan
@@ -220,7 +220,7 @@ module peak_detector #(
   // predecessor half par
   reg [AB+1:0] raddr;
   always @* begin
-    raddr = C_Q;                                  // S_MAC (rho^2 operand), S_PS
+    raddr = C_Q;                                  // S_MAC (rho^2 operand), S_P1, S_P2
     case (state)
       S_CP: if (!cp_kind)   raddr = {1'b0, ~par, cc_x[AB-1:0]};
             else if (cp == 2'd0) raddr = {1'b0, par, best_x[AB-1:0]};
@@ -325,31 +325,30 @@ module peak_detector #(
   //     (R = Q >> (SCORE_W+1) < 2^(QW-SCORE_W-1)) fits QW-SCORE_W+1. After a first quotient bit
   //     1 the score is the cap and the later (possibly wrapped) bits are not used.
   //   fraction (dsel 0): two clocks per step (dv_ph): the low DA bits, their carry registered
-  //     (dv_cl), then bits DA .. W, placed at the top of the adder (the PL bits below them add
-  //     1 + 0 and pass the carry through), so the sign is bit DA-1 of the sum in every pass and
-  //     no multiplexer follows the chain; dv_rn (the step's add / subtract) changes only after
+  //     (dv_cl), then the high W+2-DA bits; dv_rn (the step's add / subtract) changes only after
   //     the high pass, and dv_rm keeps r[DA-1] (bit DA of 2r) that the low pass overwrote.
-  localparam integer HH = W - DA + 1;   // bits DA .. W of the remainder (the sign is bit W)
-  localparam integer PL = DA - HH;      // >= 1: 2 DA >= W + 2
   reg          dv_rn, dv_ph, dv_cl, dv_rm;
   /* verilator lint_off UNUSEDSIGNAL */
-  wire [W+1:0] dv_sw = {dv_rn, dv_r, dv_q[KM-1]};   // 2r + bit
+  wire [DA+W+1:0] dv_sw = {{DA{dv_rn}}, dv_rn, dv_r, dv_q[KM-1]};   // 2r + bit, sign-extended
+  wire [2*DA-1:0] dv_dw = {{(2*DA-W){1'b0}}, dv_d};
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [DA-1:0] st_a  = dv_ph ? {dv_sw[W:DA+1], dv_rm, {PL{1'b1}}} : dv_sw[DA-1:0];
-  wire [DA-1:0] st_b  = dv_ph ? {{1'b0, dv_d[W-1:DA]} ^ {HH{~dv_rn}}, {PL{1'b0}}}
-                              : dv_d[DA-1:0] ^ {DA{~dv_rn}};
+  wire [DA-1:0] st_a  = dv_ph ? {dv_sw[2*DA-1:DA+1], dv_rm} : dv_sw[DA-1:0];
+  wire [DA-1:0] st_b  = (dv_ph ? dv_dw[2*DA-1:DA] : dv_dw[DA-1:0]) ^ {DA{~dv_rn}};
   wire          st_ci = dv_ph ? dv_cl : ~dv_rn;
   wire [DA:0]   st    = {1'b0, st_a} + {1'b0, st_b} + {{DA{1'b0}}, st_ci};
-  wire dv_sgn  = st[DA-1];                     // the sign of the step's result
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [2*DA-1:0] st_hi = {st[DA-1:0], dv_r[DA-1:0]};   // after the high pass: r' = st_hi[W-1:0]
+  /* verilator lint_on UNUSEDSIGNAL */
+  wire dv_sgn = dv_ph ? st_hi[W] : st[DA-1];   // the sign of the step's result
   wire dv_last = dv_ph || (dsel != 2'd0);      // the step's last clock
-  // den = 4 Q - 2 (Q_prev + Q_next) (mod 2^W) over two clocks, half the chain each: S_P2 the
-  // low EH bits and the borrow dn_c, S_P3 the rest (dn_b keeps dv_d[EH-1], bit EH of 2 dv_d,
-  // which S_P2 overwrote); p_rd = Q in both (no read)
+  // den = 4 Q - 2 (Q_prev + Q_next) (S_P2, mod 2^W) as a two-segment carry-select subtractor
   localparam integer EH = W / 2;
   wire [W-1:0]    den_a  = {{(W-QW){1'b0}}, p_rd} << 2;
-  wire [EH:0]     den_lo = {1'b0, den_a[EH-1:0]} - {1'b0, dv_d[EH-2:0], 1'b0};
-  reg             dn_c, dn_b;
-  wire [W-EH-1:0] den_hi = den_a[W-1:EH] - {dv_d[W-2:EH], dn_b} - {{(W-EH-1){1'b0}}, dn_c};
+  wire [W-1:0]    den_b  = dv_d << 1;
+  wire [EH:0]     den_lo = {1'b0, den_a[EH-1:0]} - {1'b0, den_b[EH-1:0]};
+  wire [W-EH-1:0] den_h0 = den_a[W-1:EH] - den_b[W-1:EH];
+  wire [W-EH-1:0] den_h1 = den_a[W-1:EH] + ~den_b[W-1:EH];   // - 1
+  wire [W-1:0]    den_cs = {den_lo[EH] ? den_h1 : den_h0, den_lo[EH-1:0]};
   // p_rd - dv_d on QW-bit operands (S_P0, S_P1: Q_prev - Q_next, Q_next - Q_prev), sign-extended
   // to W, as a two-segment carry-select subtractor (the low half's borrow picks the high half)
   localparam integer SB = (QW + 1) / 2;
@@ -490,8 +489,7 @@ module peak_detector #(
         S_P0: state <= S_P1;
         S_P1: state <= S_PS;
         S_PS: state <= S_P2;
-        S_P2: state <= S_P3;
-        S_P3: state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
+        S_P2: state <= (FRAC_W > 0) ? S_DIV : S_NEXT;
         S_DIV: if (dv_last && dv_cnt + 1'b1 == dv_k) state <= S_NEXT;
         S_NEXT: state <= (dsel == 2'd2) ? S_OUT : S_DIV;
         S_OUT: if (m_ready) state <= S_IDLE;
@@ -589,11 +587,8 @@ module peak_detector #(
       end
       S_PS: dv_d[W-1:SB] <= ps_hi;              // p_rd = Q_next again
       // den = 4Q - 2(Q_prev + Q_next)
-      S_P3: dv_d[W-1:EH] <= den_hi;
       S_P2: begin
-        dv_d[EH-1:0] <= den_lo[EH-1:0];
-        dn_c <= den_lo[EH];
-        dn_b <= dv_d[EH-1];
+        dv_d <= den_cs;
         dv_q <= {KM{1'b0}};
         dv_rn <= 1'b0;
         dv_ph <= 1'b0;
@@ -602,7 +597,7 @@ module peak_detector #(
         fmag <= {FR_W{1'b0}};
       end
       S_DIV: begin
-        if (dv_ph) dv_r[W-1:DA] <= st[DA-2:PL];
+        if (dv_ph) dv_r <= st_hi[W-1:0];
         else begin
           dv_r[DA-1:0] <= st[DA-1:0];
           dv_rm <= dv_r[DA-1];
