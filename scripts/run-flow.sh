@@ -22,6 +22,7 @@ step() { printf '\n== %s ==\n' "$*" >&2; }
 
 step "install and build"
 "$root/scripts/install-deps.sh" --hardware
+mkdir -p "$build"  # the build log goes into it before CMake creates it (fresh clone)
 "$root/scripts/build.sh" "$build" >/dev/null 2>"$build/flow-build.log" || { cat "$build/flow-build.log" >&2; exit 1; }
 
 work="$build/flow"
