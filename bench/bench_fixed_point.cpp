@@ -17,9 +17,9 @@
 #include <systemc>
 #include <vector>
 
-#include "model/bandpass_filter.hpp"
-#include "model/filter_design.hpp"
-#include "model/fixed_point.hpp"
+#include "model/dsp/bandpass_filter.hpp"
+#include "model/dsp/filter_design.hpp"
+#include "model/dsp/fixed_point.hpp"
 
 int sc_main(int, char**) { return 0; }  // libsystemc.so references it
 

@@ -2,7 +2,7 @@
 // Synthesizable HLS C++ of the fixed-point receiver: bandpass (SOS cascade) -> correlator bank
 // (mixer, one-cycle moving sum, decimation, chip FIR, code combiner, weighted power, energy
 // window) -> peak detector (gate, candidate tracking, parabolic fraction, score). It computes
-// exactly what the golden model ReceiverFixed (model/receiver.hpp) computes, bit for bit
+// exactly what the golden model ReceiverFixed (model/dsp/receiver.hpp) computes, bit for bit
 // (tests/test_hls_csim.cpp), and is a template on ONE configuration struct carrying every
 // width, size and table: the generated ranging_hls::ReceiverConfig
 // (`ranging generate` -> <out>/hls/receiver_config.hpp).
@@ -12,7 +12,7 @@
 // enforced by explicit masking / sign extension (fx:: helpers below), so g++ and the HLS tools
 // see the same arithmetic. Rounding is round half up = add half an LSB then arithmetic shift
 // right (computed as floor + (dropped bits >= half), the same value without the overflow of
-// the addition), then saturation, exactly as model/fixed_point.cpp fx_quantize.
+// the addition), then saturation, exactly as model/dsp/fixed_point.cpp fx_quantize.
 //
 // Pragmas: Vitis HLS (`#pragma HLS ...`) and Catapult (`#pragma hls_...`) are written through
 // RANGING_HLS_PRAGMA(...), which becomes `_Pragma("...")` under __SYNTHESIS__ (both tools

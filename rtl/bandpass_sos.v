@@ -6,7 +6,7 @@
 //
 // Purpose:   The receiver's bandpass filter: a cascade of SECTIONS second-order
 //            sections, bit-exact with the golden model BandpassFixed
-//            (model/bandpass_filter.cpp). Section k computes, Direct Form I,
+//            (model/dsp/bandpass_filter.cpp). Section k computes, Direct Form I,
 //
 //              acc = b0*x[n] + b1*x[n-1] + b2*x[n-2] - a1*y[n-1] - a2*y[n-2]
 //              y[n] = quantize(acc)

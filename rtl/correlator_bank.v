@@ -1,5 +1,5 @@
 // correlator_bank: the baseband matched-filter bank, bit-exact to CorrelatorBankFixed
-// (model/correlator_bank.cpp, docs/architecture.md).
+// (model/dsp/correlator_bank.cpp, docs/architecture.md).
 //
 // What it computes, per full-rate input y[n] (signed DATA_W, DATA_FRAC fraction bits):
 //   B[n]   = q_mix(y[n] * LO_COS[n mod P]), q_mix(y[n] * -LO_SIN[n mod P])   (mixer)

@@ -1,5 +1,5 @@
 // peak_detector: streaming peak picking on the correlator bank's outputs, bit-exact to
-// PeakDetectorFixed (model/peak_detector.cpp).
+// PeakDetectorFixed (model/dsp/peak_detector.cpp).
 //
 // Input: the correlator bank's outputs as GROUPS of CODES beats (AXI4-Stream with tlast): beat
 // j = 0 .. CODES-1 carries Q_j (s_weighted, WEIGHTED_W unsigned); s_energy = E and s_index = n

@@ -17,7 +17,7 @@
 //            event's arrival (receiver sample index) and the bursts' start
 //            times are on one time base. The configuration-dependent
 //            parameters come from the generated rtl/ranging_system_top.v
-//            (model/hw_system.cpp).
+//            (model/hw/hw_system.cpp).
 //
 // Status:    led_meas: stretched pulse (LED_HOLD clocks) per measurement sent;
 //            led_error: sticky ADC overrun (the receiver did not keep up with

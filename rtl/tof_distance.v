@@ -5,7 +5,7 @@
 // Project:   ranging -- coded ultrasonic ranging system
 //
 // Purpose:   Time of flight and distance of every receiver event
-//            (model: ranging::TofDistanceModel in model/hw_system.hpp, bit exact).
+//            (model: ranging::TofDistanceModel in model/hw/hw_system.hpp, bit exact).
 //
 //            For an event {code j, arrival a} (a: signed full-rate sample index
 //            with FRAC_W fraction bits, the correlation peak of the receiver):

@@ -11,7 +11,7 @@
 //            chip m is
 //              ph   = (2 CYC n + (c_m + 1) SPC) mod 2 SPC
 //              sign = ph < SPC ? +1 : -1
-//            exactly model/excitation.cpp hbridge_drive (CYC = q carrier cycles
+//            exactly model/dsp/excitation.cpp hbridge_drive (CYC = q carrier cycles
 //            per chip, SPC = q fs / f samples per chip, c_m the chip bit). The
 //            phase is kept as a counter stepped by 2 CYC mod 2 SPC (no divider).
 //            Outside a burst both legs are off (hb_p = hb_n = 0).

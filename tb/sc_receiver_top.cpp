@@ -11,9 +11,10 @@
 #include <random>
 
 #include "Vreceiver_top.h"
-#include "model/channel.hpp"
-#include "model/excitation.hpp"
-#include "model/receiver.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/sim/channel.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/dsp/receiver.hpp"
 
 using namespace sc_core;
 using ranging::EventFixed;

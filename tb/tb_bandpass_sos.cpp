@@ -20,12 +20,13 @@
 #include <vector>
 
 #include "Vbandpass_sos.h"
-#include "model/bandpass_filter.hpp"
-#include "model/channel.hpp"
-#include "model/codes.hpp"
-#include "model/excitation.hpp"
-#include "model/hw_params.hpp"
-#include "model/receiver.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/dsp/bandpass_filter.hpp"
+#include "model/sim/channel.hpp"
+#include "model/dsp/codes.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/hw/hw_params.hpp"
+#include "model/dsp/receiver.hpp"
 #include "tb/verilator_harness.hpp"
 
 namespace {

@@ -21,10 +21,11 @@
 #include <string>
 #include <vector>
 
-#include "model/bandpass_filter.hpp"
-#include "model/channel.hpp"
-#include "model/excitation.hpp"
-#include "model/receiver.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/dsp/bandpass_filter.hpp"
+#include "model/sim/channel.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/dsp/receiver.hpp"
 // Verilator's runtime headers are not warning-clean under -Wextra -Werror.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-parameter"

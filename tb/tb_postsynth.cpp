@@ -16,10 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "model/channel.hpp"
-#include "model/excitation.hpp"
-#include "model/hw_params.hpp"
-#include "model/receiver.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/sim/channel.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/hw/hw_params.hpp"
+#include "model/dsp/receiver.hpp"
 
 using namespace ranging;
 namespace fs = std::filesystem;

@@ -1,5 +1,5 @@
 // The whole ranging system (rtl/ranging_system.v around the generated receiver) in a closed
-// loop against the model: the channel model (model/channel.hpp: TX and RX transducers,
+// loop against the model: the channel model (model/sim/channel.hpp: TX and RX transducers,
 // propagation delay, noise) turns the transmit schedule into the ADC pins; the H-bridge drive
 // is checked sample by sample against hbridge_drive; the UART line is decoded into frames and
 // every frame is checked field by field against ReceiverFixed + TofDistanceModel fed with the
@@ -23,10 +23,11 @@
 #include "Vranging_system.h"
 #include "tb/verilator_harness.hpp"
 #pragma GCC diagnostic pop
-#include "model/channel.hpp"
-#include "model/excitation.hpp"
-#include "model/hw_system.hpp"
-#include "model/receiver.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/sim/channel.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/hw/hw_system.hpp"
+#include "model/dsp/receiver.hpp"
 
 using namespace ranging;
 

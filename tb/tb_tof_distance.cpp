@@ -1,4 +1,4 @@
-// rtl/tof_distance.v against ranging::TofDistanceModel (model/hw_system.hpp), bit for bit:
+// rtl/tof_distance.v against ranging::TofDistanceModel (model/hw/hw_system.hpp), bit for bit:
 // every measurement {code, flags, ToF, distance, score, margin} on directed corners and random
 // events. The parameters are the generated system's (tb/tof_distance.cmake).
 #include <gtest/gtest.h>
@@ -8,8 +8,9 @@
 #include <string>
 
 #include "Vtof_distance.h"
-#include "model/hw_system.hpp"
-#include "model/receiver.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/hw/hw_system.hpp"
+#include "model/dsp/receiver.hpp"
 #include "tb/verilator_harness.hpp"
 
 namespace {

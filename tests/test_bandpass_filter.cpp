@@ -1,4 +1,4 @@
-// The bandpass SOS cascade in both precisions (model/bandpass_filter.hpp) on the paper's
+// The bandpass SOS cascade in both precisions (model/dsp/bandpass_filter.hpp) on the paper's
 // design (design_bandpass defaults: Butterworth order 5, 150-250 kHz at 5 MS/s).
 //
 // Bounds used below (docs/fixed-point.md derives them):
@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "model/bandpass_filter.hpp"
-#include "model/error.hpp"
-#include "model/filter_design.hpp"
-#include "model/fixed_point.hpp"
+#include "model/dsp/bandpass_filter.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/filter_design.hpp"
+#include "model/dsp/fixed_point.hpp"
 
 namespace ranging {
 namespace {

@@ -12,8 +12,8 @@
 #include <memory>
 #include <sstream>
 
-#include "model/capture.hpp"
-#include "model/error.hpp"
+#include "model/sim/capture.hpp"
+#include "model/base/error.hpp"
 
 using namespace ranging;
 namespace fs = std::filesystem;

@@ -9,12 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "model/channel.hpp"
-#include "model/error.hpp"
-#include "model/excitation.hpp"
-#include "model/filter_design.hpp"
-#include "model/metrics.hpp"
-#include "model/transducer.hpp"
+#include "model/sim/channel.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/dsp/filter_design.hpp"
+#include "model/sim/metrics.hpp"
+#include "model/dsp/transducer.hpp"
 
 using namespace ranging;
 

@@ -1,7 +1,7 @@
 // The command-line parser: bad input is refused with a message naming the option.
 #include <gtest/gtest.h>
 
-#include "model/error.hpp"
+#include "model/base/error.hpp"
 #include "tool/cli.hpp"
 
 TEST(Cli, ParsesOptionsFlagsAndPositionals) {

@@ -17,8 +17,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "model/codes.hpp"
-#include "model/error.hpp"
+#include "model/dsp/codes.hpp"
+#include "model/base/error.hpp"
 
 using ranging::Code;
 using ranging::InputError;

@@ -3,10 +3,10 @@
 
 #include <cmath>
 
-#include "model/correlator_bank.hpp"
-#include "model/error.hpp"
-#include "model/peak_detector.hpp"
-#include "model/receiver.hpp"
+#include "model/dsp/correlator_bank.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/peak_detector.hpp"
+#include "model/dsp/receiver.hpp"
 
 using namespace ranging;
 

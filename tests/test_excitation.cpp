@@ -7,8 +7,8 @@
 #include <numbers>
 #include <vector>
 
-#include "model/error.hpp"
-#include "model/excitation.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/excitation.hpp"
 
 using namespace ranging;
 

@@ -16,8 +16,8 @@
 #include <string>
 #include <unistd.h>
 
-#include "model/error.hpp"
-#include "model/filter_design.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/filter_design.hpp"
 
 namespace ranging {
 namespace {

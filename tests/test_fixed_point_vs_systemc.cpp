@@ -1,4 +1,4 @@
-// Proof of model/fixed_point.hpp against an independent implementation: SystemC's fixed-point
+// Proof of model/dsp/fixed_point.hpp against an independent implementation: SystemC's fixed-point
 // types (IEEE 1666 sc_fix / sc_ufix with runtime parameters, and the sc_fixed templates).
 // Every rounding x overflow mode, widths 2..48 (plus 49..64), signed and unsigned, random
 // fracs (negative and > width included); results compared bit for bit, overflow events
@@ -18,8 +18,8 @@
 #include <string>
 #include <systemc>
 
-#include "model/error.hpp"
-#include "model/fixed_point.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/fixed_point.hpp"
 
 int sc_main(int, char**) { return 0; }
 

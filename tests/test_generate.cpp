@@ -8,11 +8,12 @@
 #include <memory>
 #include <sstream>
 
-#include "model/demo.hpp"
-#include "model/error.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/sim/demo.hpp"
+#include "model/base/error.hpp"
 #include "tests/process.hpp"
-#include "model/hw_generator.hpp"
-#include "model/hw_params.hpp"
+#include "model/hw/hw_generator.hpp"
+#include "model/hw/hw_params.hpp"
 
 using namespace ranging;
 namespace fs = std::filesystem;

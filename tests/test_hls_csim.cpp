@@ -25,9 +25,10 @@
 
 #include "generated/default/hls/receiver_config.hpp"
 #include "hls/receiver_hls.hpp"
-#include "model/channel.hpp"
-#include "model/excitation.hpp"
-#include "model/receiver.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/sim/channel.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/dsp/receiver.hpp"
 
 namespace fs = std::filesystem;
 using namespace ranging;

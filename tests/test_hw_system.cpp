@@ -1,4 +1,4 @@
-// The ranging system's generated parameters (model/hw_system.hpp): burst period from eq. 3/4,
+// The ranging system's generated parameters (model/hw/hw_system.hpp): burst period from eq. 3/4,
 // transmit drive, time of flight model, refusals, and the committed generated system files.
 #include <gtest/gtest.h>
 
@@ -6,11 +6,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "model/error.hpp"
-#include "model/excitation.hpp"
-#include "model/hw_system.hpp"
-#include "model/metrics.hpp"
-#include "model/receiver.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/hw/hw_system.hpp"
+#include "model/sim/metrics.hpp"
+#include "model/dsp/receiver.hpp"
 
 using namespace ranging;
 

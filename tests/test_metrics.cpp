@@ -4,8 +4,8 @@
 #include <cmath>
 #include <vector>
 
-#include "model/error.hpp"
-#include "model/metrics.hpp"
+#include "model/base/error.hpp"
+#include "model/sim/metrics.hpp"
 
 using namespace ranging;
 

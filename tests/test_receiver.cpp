@@ -6,10 +6,11 @@
 #include <fstream>
 #include <memory>
 
-#include "model/demo.hpp"
-#include "model/error.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/sim/demo.hpp"
+#include "model/base/error.hpp"
 #include "tests/process.hpp"
-#include "model/receiver.hpp"
+#include "model/dsp/receiver.hpp"
 
 using namespace ranging;
 

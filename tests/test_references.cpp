@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "model/capture.hpp"
+#include "model/sim/capture.hpp"
 #include "tests/process.hpp"
 
 using namespace ranging;

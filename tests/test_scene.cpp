@@ -9,10 +9,10 @@
 #include <fstream>
 #include <memory>
 
-#include "model/error.hpp"
-#include "model/medium.hpp"
-#include "model/scene.hpp"
-#include "model/scene_simulator.hpp"
+#include "model/base/error.hpp"
+#include "model/sim/medium.hpp"
+#include "model/sim/scene.hpp"
+#include "model/sim/scene_simulator.hpp"
 
 using namespace ranging;
 

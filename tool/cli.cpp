@@ -5,7 +5,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "model/error.hpp"
+#include "model/base/error.hpp"
 
 namespace cli {
 

@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "model/codes.hpp"
-#include "model/error.hpp"
+#include "model/dsp/codes.hpp"
+#include "model/base/error.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 

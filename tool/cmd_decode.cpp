@@ -1,5 +1,5 @@
 // `ranging decode CAPTURE --family NAME`: decode a recorded received signal (an oscilloscope
-// CSV export or a WAV file, model/capture.hpp) with the receiver and the paper's Pearson
+// CSV export or a WAV file, model/sim/capture.hpp) with the receiver and the paper's Pearson
 // decoder; print every received burst: code j, ToF, distance, rho_max, u.
 #include <nlohmann/json.hpp>
 
@@ -8,12 +8,12 @@
 #include <iostream>
 #include <sstream>
 
-#include "model/capture.hpp"
-#include "model/codes.hpp"
-#include "model/error.hpp"
-#include "model/medium.hpp"
-#include "model/scene.hpp"
-#include "model/scene_simulator.hpp"
+#include "model/sim/capture.hpp"
+#include "model/dsp/codes.hpp"
+#include "model/base/error.hpp"
+#include "model/sim/medium.hpp"
+#include "model/sim/scene.hpp"
+#include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 

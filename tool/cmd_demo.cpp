@@ -1,4 +1,4 @@
-// `ranging demo`: the main job at this stage (model/demo.hpp).
+// `ranging demo`: the main job at this stage (model/sim/demo.hpp).
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
@@ -7,8 +7,9 @@
 #include <iostream>
 #include <sstream>
 
-#include "model/demo.hpp"
-#include "model/error.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/sim/demo.hpp"
+#include "model/base/error.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 

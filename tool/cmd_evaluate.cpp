@@ -13,10 +13,10 @@
 #include <map>
 #include <sstream>
 
-#include "model/capture.hpp"
-#include "model/error.hpp"
-#include "model/scene.hpp"
-#include "model/scene_simulator.hpp"
+#include "model/sim/capture.hpp"
+#include "model/base/error.hpp"
+#include "model/sim/scene.hpp"
+#include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 #include "tool/scene_run.hpp"

@@ -9,9 +9,9 @@
 #include <string_view>
 #include <vector>
 
-#include "model/error.hpp"
-#include "model/filter_design.hpp"
-#include "model/quantize.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/filter_design.hpp"
+#include "model/dsp/quantize.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 

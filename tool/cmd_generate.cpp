@@ -1,9 +1,10 @@
 // `ranging generate`: the hardware files of one receiver configuration (docs/hardware.md).
 #include <iostream>
 
-#include "model/error.hpp"
-#include "model/hw_generator.hpp"
-#include "model/hw_params.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/base/error.hpp"
+#include "model/hw/hw_generator.hpp"
+#include "model/hw/hw_params.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 

@@ -1,4 +1,4 @@
-// `ranging simulate SCENE`: run a scene (model/scene_simulator.hpp) and write one CSV row per
+// `ranging simulate SCENE`: run a scene (model/sim/scene_simulator.hpp) and write one CSV row per
 // measurement and a summary JSON. Also home of the helpers `ranging evaluate` shares
 // (tool/scene_run.hpp).
 #include <nlohmann/json.hpp>
@@ -12,10 +12,10 @@
 #include <iostream>
 #include <sstream>
 
-#include "model/capture.hpp"
-#include "model/error.hpp"
-#include "model/scene.hpp"
-#include "model/scene_simulator.hpp"
+#include "model/sim/capture.hpp"
+#include "model/base/error.hpp"
+#include "model/sim/scene.hpp"
+#include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 #include "tool/scene_run.hpp"

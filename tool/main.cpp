@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "model/error.hpp"
+#include "model/base/error.hpp"
 #include "tool/commands.hpp"
 
 namespace {

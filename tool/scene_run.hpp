@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "model/scene_simulator.hpp"
+#include "model/sim/scene_simulator.hpp"
 
 namespace ranging::tool {
 

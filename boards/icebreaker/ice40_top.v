@@ -10,7 +10,7 @@
 //            (boards/icebreaker/icebreaker.pcf, docs/bitstream.md).
 //
 // Clock:     the PLL settings come from the generated rtl/ice40_pll.vh
-//            (`ranging generate`, model/hw_system.cpp: ice40_pll, the same search
+//            (`ranging generate`, model/hw/hw_system.cpp: ice40_pll, the same search
 //            as `icepll -i 12 -o <MHz>`); the default 30 MHz is DIVR 0, DIVF 79,
 //            DIVQ 5, FILTER_RANGE 1: F_PFD 12 MHz, F_VCO 960 MHz, exact,
 //            = 6 x 5 MS/s (CLK_DIV 6) = 20 x 1.5 Mbaud (BAUD_DIV 20).

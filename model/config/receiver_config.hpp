@@ -1,0 +1,17 @@
+#pragma once
+// The receiver configuration file (configs/*.yaml, docs/configuration.md): parse, load and
+// write a ReceiverConfig. Unknown keys, wrong types and out-of-range values are errors naming
+// the file, line and key; the values are checked by validate() (model/dsp/receiver.hpp).
+#include <string>
+
+#include "model/dsp/receiver.hpp"
+
+namespace ranging {
+
+// YAML (docs/configuration.md). Unknown keys, wrong types and out-of-range values are
+// errors naming the file, line and key.
+ReceiverConfig load_receiver_config(const std::string& path);
+ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin);
+std::string receiver_config_yaml(const ReceiverConfig& cfg);
+
+}  // namespace ranging

@@ -1,0 +1,247 @@
+#include "model/dsp/bandpass_filter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <sstream>
+
+#include "model/base/error.hpp"
+#include "model/dsp/quantize.hpp"
+
+namespace ranging {
+
+namespace {
+
+const char* const kCoefNames[5] = {"b0", "b1", "b2", "a1", "a2"};
+
+void require_sections(const SosFilter& filter) {
+  if (filter.sections.empty()) throw InputError("bandpass filter sections: none given; need at least 1");
+}
+
+std::vector<std::vector<std::int64_t>> quantize_sections(const BandpassFixedConfig& c, const SosFilter& filter) {
+  std::vector<std::vector<std::int64_t>> q;
+  for (std::size_t k = 0; k < filter.sections.size(); ++k) {
+    const Biquad& s = filter.sections[k];
+    const double v[5] = {s.b0, s.b1, s.b2, s.a1, s.a2};
+    std::vector<std::int64_t> row(5);
+    for (int i = 0; i < 5; ++i) {
+      row[i] = quantize_coefficient(v[i], c.coef_bits, c.coef_frac,
+                                    "section " + std::to_string(k + 1) + " " + kCoefNames[i]);
+    }
+    q.push_back(std::move(row));
+  }
+  return q;
+}
+
+void validate_words(const BandpassFixedConfig& c) {
+  require_in_range("input_bits", c.input_bits, 2, 32);
+  require_in_range("coef_bits", c.coef_bits, 2, 62);
+  require_in_range("coef_frac", c.coef_frac, 0, 62);
+  require_in_range("data_bits", c.data_bits, 2, 64);
+  require_in_range("data_frac", c.data_frac, c.input_bits - 1, 62);
+  require_in_range("acc_bits", c.acc_bits, 2, 64);
+}
+
+int128_t abs128(std::int64_t v) { return v < 0 ? -static_cast<int128_t>(v) : static_cast<int128_t>(v); }
+
+// Minimum signed accumulator width, from the quantized coefficients (requires valid words,
+// so every magnitude below is < 2^63 and the sum < 2^127).
+int min_acc_bits(const BandpassFixedConfig& c, const std::vector<std::vector<std::int64_t>>& coef) {
+  const int128_t x0_max = static_cast<int128_t>(1) << c.data_frac;      // input -1 aligned
+  const int128_t data_max = static_cast<int128_t>(1) << (c.data_bits - 1);  // |most negative code|
+  int128_t worst = 0;
+  for (std::size_t k = 0; k < coef.size(); ++k) {
+    const auto& q = coef[k];
+    const int128_t x_max = (k == 0) ? x0_max : data_max;
+    const int128_t bound = (abs128(q[0]) + abs128(q[1]) + abs128(q[2])) * x_max + (abs128(q[3]) + abs128(q[4])) * data_max;
+    worst = std::max(worst, bound);
+  }
+  int bits = 1;  // sign bit; then magnitude bits until 2^(bits-1) - 1 >= worst
+  while (bits < 128 && (static_cast<int128_t>(1) << (bits - 1)) - 1 < worst) ++bits;
+  return bits;
+}
+
+double pole_radius_of(const Biquad& s) {
+  const double d = s.a1 * s.a1 - 4.0 * s.a2;
+  if (d < 0) return std::sqrt(s.a2);
+  const double r = std::sqrt(d);
+  return std::max(std::abs(-s.a1 + r), std::abs(-s.a1 - r)) / 2.0;
+}
+
+// ||h||_1 of the chain of sections (a section may be a pure all-pole 1/A), by simulation
+// until the response has decayed by 1e-15 of its start; +inf if a pole is on or outside
+// the unit circle.
+double l1_norm(const std::vector<Biquad>& chain) {
+  double r = 0;
+  for (const Biquad& s : chain) r = std::max(r, pole_radius_of(s));
+  if (!(r < 1.0)) return std::numeric_limits<double>::infinity();
+  // A repeated pole decays like n^m r^n; three time constants past 1e-15 covers it.
+  const double n_decay = std::log(1e-15) / std::log(std::max(r, 0.5));
+  const auto length = static_cast<std::size_t>(std::min(3.0 * n_decay + 256.0, 4e6));
+  BandpassFloat f(SosFilter{FilterType::Butterworth, 0, 1.0, chain});
+  double sum = 0;
+  for (std::size_t n = 0; n < length; ++n) sum += std::abs(f.execute(n == 0 ? 1.0 : 0.0));
+  return sum;
+}
+
+Biquad all_pole(const Biquad& s) { return Biquad{1, 0, 0, s.a1, s.a2}; }
+
+}  // namespace
+
+void validate(const BandpassFixedConfig& config, const SosFilter& filter) {
+  validate_words(config);
+  require_sections(filter);
+  const auto coef = quantize_sections(config, filter);
+  const int need = min_acc_bits(config, coef);
+  if (config.acc_bits < need) {
+    std::ostringstream os;
+    os << "acc_bits: " << config.acc_bits << " can overflow for this filter and these word lengths; "
+       << "valid range is [" << need << ", 64] (worst case sum of products needs " << need << " bits)";
+    throw InputError(os.str());
+  }
+}
+
+int bandpass_min_acc_bits(const BandpassFixedConfig& config, const SosFilter& filter) {
+  validate_words(config);
+  require_sections(filter);
+  return min_acc_bits(config, quantize_sections(config, filter));
+}
+
+BandpassHeadroom bandpass_headroom(const BandpassFixedConfig& config, const SosFilter& filter) {
+  validate(config, filter);
+  const auto coef = quantize_sections(config, filter);
+  std::vector<Biquad> q;
+  for (const auto& c : coef) {
+    const double s = std::ldexp(1.0, -config.coef_frac);
+    q.push_back(Biquad{c[0] * s, c[1] * s, c[2] * s, c[3] * s, c[4] * s});
+  }
+  const double lsb = std::ldexp(1.0, -config.data_frac);
+  const double max_error = (config.rounding == Rounding::Truncate) ? lsb : lsb / 2;
+  BandpassHeadroom h;
+  h.limit = std::ldexp(static_cast<double>(fx_max_raw(FixedFormat{config.data_bits, config.data_frac})), -config.data_frac);
+  h.no_overflow = true;
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    const std::vector<Biquad> to_k(q.begin(), q.begin() + static_cast<std::ptrdiff_t>(k) + 1);
+    double noise = 0;
+    for (std::size_t j = 0; j <= k; ++j) {
+      std::vector<Biquad> from_j{all_pole(q[j])};
+      from_j.insert(from_j.end(), q.begin() + static_cast<std::ptrdiff_t>(j) + 1,
+                    q.begin() + static_cast<std::ptrdiff_t>(k) + 1);
+      noise += max_error * l1_norm(from_j);
+    }
+    // The most negative input, -1, is the largest magnitude the input word holds.
+    const double gain = l1_norm(to_k);
+    h.signal_gain.push_back(gain);
+    h.noise_bound.push_back(noise);
+    h.peak_bound.push_back(gain + noise);
+    // Tiny relative margin for the double-precision evaluation of the norms.
+    if (!((gain + noise) * (1 + 1e-9) <= h.limit)) h.no_overflow = false;
+  }
+  return h;
+}
+
+BandpassFilter::~BandpassFilter() = default;
+
+void BandpassFilter::execute_block(std::span<const double> in, std::span<double> out) {
+  if (in.size() != out.size()) {
+    throw InputError("bandpass execute_block: output size " + std::to_string(out.size()) +
+                     " differs from input size " + std::to_string(in.size()) + "; they must be equal");
+  }
+  for (std::size_t i = 0; i < in.size(); ++i) out[i] = execute(in[i]);
+}
+
+// ---- double precision reference ------------------------------------------------------------
+
+BandpassFloat::BandpassFloat(const SosFilter& filter) : sections_(filter.sections) {
+  require_sections(filter);
+  for (const Biquad& s : sections_) {
+    for (double v : {s.b0, s.b1, s.b2, s.a1, s.a2}) require_finite("bandpass coefficient", v);
+  }
+  reset();
+}
+
+void BandpassFloat::reset() {
+  state_.assign(sections_.size(), State{});
+  out_.assign(sections_.size(), 0.0);
+}
+
+double BandpassFloat::execute(double x) {
+  for (std::size_t k = 0; k < sections_.size(); ++k) {
+    const Biquad& c = sections_[k];
+    State& s = state_[k];
+    const double y = c.b0 * x + c.b1 * s.x1 + c.b2 * s.x2 - c.a1 * s.y1 - c.a2 * s.y2;
+    s.x2 = s.x1;
+    s.x1 = x;
+    s.y2 = s.y1;
+    s.y1 = y;
+    out_[k] = y;
+    x = y;
+  }
+  return x;
+}
+
+// ---- bit-accurate fixed point --------------------------------------------------------------
+
+BandpassFixed::BandpassFixed(const SosFilter& filter, const BandpassFixedConfig& config)
+    : filter_(filter), config_(config) {
+  validate(config, filter);
+  coef_ = quantize_sections(config, filter);
+  input_fmt_ = FixedFormat{config.input_bits, config.input_bits - 1, true, Rounding::RoundHalfUp, Overflow::Saturate};
+  data_fmt_ = FixedFormat{config.data_bits, config.data_frac, true, config.rounding, config.overflow};
+  input_shift_ = config.data_frac - (config.input_bits - 1);
+  reset();
+}
+
+void BandpassFixed::reset() {
+  state_.assign(coef_.size(), State{});
+  out_.assign(coef_.size(), 0);
+  section_events_ = {};
+  input_events_ = {};
+}
+
+std::int64_t BandpassFixed::execute_raw(std::int64_t x_in) {
+  if (x_in < fx_min_raw(input_fmt_) || x_in > fx_max_raw(input_fmt_)) {
+    std::ostringstream os;
+    os << "bandpass input sample: " << x_in << " is out of range; valid range is [" << fx_min_raw(input_fmt_)
+       << ", " << fx_max_raw(input_fmt_) << "] (signed " << config_.input_bits << "-bit)";
+    throw InputError(os.str());
+  }
+  // Aligning the input to data_frac is wiring (a multiply by 2^shift, never an overflow:
+  // |x| <= 2^data_frac <= 2^62).
+  std::int64_t x = x_in * (std::int64_t{1} << input_shift_);
+  const int acc_frac = accumulator_frac();
+  for (std::size_t k = 0; k < coef_.size(); ++k) {
+    const std::int64_t* c = coef_[k].data();
+    State& s = state_[k];
+    // Exact: validate() proved every partial sum fits acc_bits <= 64 bits.
+    std::int64_t acc = c[0] * x + c[2] * s.x2 - c[3] * s.y1 - c[4] * s.y2;
+    if (c[1] != 0) acc += c[1] * s.x1;  // zero b1 (g*[1,0,-1] numerators): no multiplier
+    const std::int64_t y = fx_quantize(acc, acc_frac, data_fmt_, &section_events_);
+    s.x2 = s.x1;
+    s.x1 = x;
+    s.y2 = s.y1;
+    s.y1 = y;
+    out_[k] = y;
+    x = y;
+  }
+  return x;
+}
+
+double BandpassFixed::execute(double x) {
+  require_finite("bandpass input sample", x);
+  const Fixed in(x, input_fmt_, &input_events_);
+  return std::ldexp(static_cast<double>(execute_raw(in.raw())), -config_.data_frac);
+}
+
+SosFilter BandpassFixed::quantized_filter() const {
+  SosFilter q = filter_;
+  const double s = std::ldexp(1.0, -config_.coef_frac);
+  for (std::size_t k = 0; k < coef_.size(); ++k) {
+    const auto& c = coef_[k];
+    q.sections[k] = Biquad{c[0] * s, c[1] * s, c[2] * s, c[3] * s, c[4] * s};
+  }
+  return q;
+}
+
+}  // namespace ranging

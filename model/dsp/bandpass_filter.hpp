@@ -1,0 +1,122 @@
+#pragma once
+// The receiver's bandpass filter as a cascade of second-order sections (paper 3.3.1), in two
+// precisions behind one interface (liquid-dsp style: create, execute, reset):
+//   * BandpassFloat: double precision reference, Direct Form I;
+//   * BandpassFixed: the bit-accurate model of the hardware, Direct Form I per section:
+//       acc = b0*x + b1*x1 + b2*x2 - a1*y1 - a2*y2     (exact integer, acc_bits wide)
+//       y   = fx_quantize(acc, coef_frac + data_frac, data format, rounding, overflow)
+//     one quantizer per section, nothing else rounds or overflows. Every word length is
+//     configuration; see docs/fixed-point.md for the node-by-node table.
+// Samples are in full-scale units: the ADC range is [-1, 1).
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "model/dsp/fixed_point.hpp"
+#include "model/dsp/sos.hpp"
+
+namespace ranging {
+
+struct BandpassFixedConfig {  // every word length is configuration
+  int input_bits = 12;        // ADC word: signed, Q0.(input_bits-1), full scale [-1, 1)
+  int coef_bits = 16;         // coefficients: signed, coef_frac fraction bits,
+  int coef_frac = 14;         //   quantized by quantize_coefficient (refused if not fitting)
+  int data_bits = 16;         // every section's output (and the cascade output): signed,
+  int data_frac = 14;         //   Q2.14 = [-2, 2): the worst-case gain of the paper's
+                              //   design (~1.93) needs the second integer bit
+  int acc_bits = 40;          // section accumulator; validate() refuses it unless it holds
+                              //   the worst case sum of products
+  Rounding rounding = Rounding::RoundHalfUp;  // accumulator -> section output
+  Overflow overflow = Overflow::Saturate;     // section output (counted)
+};
+
+// Throws InputError naming the field and its valid range unless the configuration is
+// realizable for `filter`: input_bits 2..32, coef_bits 2..62, coef_frac 0..62, data_bits
+// 2..64, data_frac input_bits-1..62 (the input aligns to the data format without rounding),
+// every coefficient fits (field "section k b0" etc.), and acc_bits >= the minimum below.
+void validate(const BandpassFixedConfig& config, const SosFilter& filter);
+
+// Smallest accumulator (signed bits) that holds sum |b_i| * max|x| + sum |a_i| * max|y| for
+// every section, with the quantized coefficients and the full ranges of the input and data
+// words. With it the accumulator cannot overflow for any input.
+int bandpass_min_acc_bits(const BandpassFixedConfig& config, const SosFilter& filter);
+
+// Worst-case magnitude bound at each section output (full-scale units), for inputs in the
+// input word's range and no saturation upstream:
+//   signal_gain[k]  = ||h_k||_1, h_k the impulse response from the input to node k with the
+//                     quantized coefficients (the gain the worst-case input reaches);
+//   noise_bound[k]  = sum over sections j <= k of (LSB/2 or LSB for Truncate) * ||g_jk||_1,
+//                     g_jk the response from section j's quantizer to node k;
+//   peak_bound[k]   = signal_gain[k] * 1 + noise_bound[k];
+//   limit[k]        = largest value the data word holds;
+//   no_overflow     = peak_bound[k] <= limit for every k: the configuration's headroom claim.
+struct BandpassHeadroom {
+  std::vector<double> signal_gain, noise_bound, peak_bound;
+  double limit = 0;
+  bool no_overflow = false;
+};
+BandpassHeadroom bandpass_headroom(const BandpassFixedConfig& config, const SosFilter& filter);
+
+class BandpassFilter {  // same API for every precision
+ public:
+  virtual ~BandpassFilter();
+  virtual void reset() = 0;                 // back to the all-zero initial state
+  virtual double execute(double x) = 0;     // one sample in, one out (full-scale units)
+  // out[i] = execute(in[i]); throws InputError unless the sizes match.
+  void execute_block(std::span<const double> in, std::span<double> out);
+};
+
+class BandpassFloat final : public BandpassFilter {
+ public:
+  explicit BandpassFloat(const SosFilter& filter);  // throws InputError if no sections
+  void reset() override;
+  double execute(double x) override;
+  const std::vector<double>& section_outputs() const { return out_; }
+
+ private:
+  struct State {
+    double x1 = 0, x2 = 0, y1 = 0, y2 = 0;
+  };
+  std::vector<Biquad> sections_;
+  std::vector<State> state_;
+  std::vector<double> out_;
+};
+
+class BandpassFixed final : public BandpassFilter {
+ public:
+  BandpassFixed(const SosFilter& filter, const BandpassFixedConfig& config);  // validates
+  void reset() override;  // also clears the overflow counters
+  // Quantizes x to the input word (RoundHalfUp, Saturate, counted in
+  // input_overflow_events()) and returns the output as a double.
+  double execute(double x) override;
+  // Input: signed input_bits integer (InputError if outside); output: signed data_bits
+  // integer with data_frac fraction bits.
+  std::int64_t execute_raw(std::int64_t x);
+
+  const std::vector<std::int64_t>& section_outputs() const { return out_; }  // last sample, per section
+  const std::vector<std::vector<std::int64_t>>& coefficients() const { return coef_; }  // {b0,b1,b2,a1,a2}
+  OverflowCounter overflow_events() const { return section_events_; }  // section outputs
+  OverflowCounter input_overflow_events() const { return input_events_; }  // execute(double)
+  const BandpassFixedConfig& config() const { return config_; }
+  FixedFormat input_format() const { return input_fmt_; }
+  FixedFormat data_format() const { return data_fmt_; }
+  int accumulator_frac() const { return config_.coef_frac + config_.data_frac; }
+  // The designed filter with the quantized coefficients: what the integers implement.
+  SosFilter quantized_filter() const;
+
+ private:
+  struct State {
+    std::int64_t x1 = 0, x2 = 0, y1 = 0, y2 = 0;
+  };
+  SosFilter filter_;
+  BandpassFixedConfig config_;
+  FixedFormat input_fmt_, data_fmt_;
+  int input_shift_ = 0;  // data_frac - (input_bits - 1)
+  std::vector<std::vector<std::int64_t>> coef_;
+  std::vector<State> state_;
+  std::vector<std::int64_t> out_;
+  OverflowCounter section_events_, input_events_;
+};
+
+}  // namespace ranging

@@ -1,0 +1,355 @@
+#include "model/dsp/correlator_bank.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "model/base/error.hpp"
+
+namespace ranging {
+namespace {
+
+int ceil_log2(std::int64_t v) {
+  int b = 0;
+  while ((std::int64_t{1} << b) < v) ++b;
+  return b;
+}
+
+int bits_for_magnitude(double bound) {  // signed width holding [-bound, bound]
+  return static_cast<int>(std::ceil(std::log2(bound + 1.0))) + 1;
+}
+
+void check_reference(const CorrelatorReference& r) {
+  require_in_range("correlator: samples per carrier cycle (fs/f)", r.period, 2, 4096);
+  require_in_range("correlator: samples per chip", r.chip_samples, r.period, 1 << 16);
+  if (r.chip_samples % r.period != 0) {
+    throw InputError("correlator: samples per chip must be a whole number of carrier cycles");
+  }
+  require_in_range("correlator.decimation", r.decimation, 1, r.chip_samples);
+  if (r.chip_samples % r.decimation != 0) {
+    throw InputError("correlator.decimation: " + std::to_string(r.decimation) +
+                     " must divide the samples per chip (" + std::to_string(r.chip_samples) + ")");
+  }
+  require_in_range("correlator: chip template taps", static_cast<double>(r.chip_taps.size()), 1, 4096);
+  if (r.codes.empty()) throw InputError("correlator: the code family has no codes");
+  for (const auto& c : r.codes) {
+    if (c.size() != r.codes.front().size() || c.empty()) {
+      throw InputError("correlator: all codes must have the same, non-zero length");
+    }
+  }
+  if (r.code_gain.size() != r.codes.size()) {
+    throw InputError("correlator: one normalization gain per code is required");
+  }
+  for (double k : r.code_gain) require_in_range("correlator: code normalization gain", k, 1e-30, 1e30);
+  require_in_range("correlator: energy window", r.window, 1, 1 << 24);
+}
+
+std::vector<std::vector<int>> code_signs(const std::vector<std::vector<std::uint8_t>>& codes) {
+  std::vector<std::vector<int>> signs;
+  for (const auto& c : codes) {
+    std::vector<int> s;
+    for (std::uint8_t chip : c) s.push_back(chip ? 1 : -1);
+    signs.push_back(std::move(s));
+  }
+  return signs;
+}
+
+std::size_t combiner_history(const CorrelatorReference& r) {
+  const std::size_t chips = r.codes.front().size();
+  return (chips - 1) * static_cast<std::size_t>(r.chip_samples / r.decimation) + 1;
+}
+
+}  // namespace
+
+std::uint64_t correlation_score(std::uint64_t weighted_power, std::uint64_t norm, int score_bits) {
+  const std::uint64_t cap = (std::uint64_t{1} << score_bits) - 1;
+  const std::uint64_t q = weighted_power / std::max<std::uint64_t>(norm, 1);
+  return q > cap ? cap : q;
+}
+
+// ---------------------------------------------------------------------------------------
+// Layout: every exact node's width follows from its bound, so no exact node can overflow.
+
+CorrelatorFixedLayout resolve_correlator_layout(const CorrelatorReference& ref,
+                                                const CorrelatorFixedConfig& cfg) {
+  check_reference(ref);
+  require_in_range("correlator_fixed.data_bits", cfg.data_bits, 2, 32);
+  require_in_range("correlator_fixed.data_frac", cfg.data_frac, 0, cfg.data_bits - 1);
+  require_in_range("correlator_fixed.lo_bits", cfg.lo_bits, 3, 24);
+  require_in_range("correlator_fixed.mix_bits", cfg.mix_bits, 2, 32);
+  require_in_range("correlator_fixed.tap_bits", cfg.tap_bits, 2, 24);
+  require_in_range("correlator_fixed.chip_bits", cfg.chip_bits, 2, 40);
+  require_in_range("correlator_fixed.corr_bits", cfg.corr_bits, 2, 31);
+  require_in_range("correlator_fixed.weight_bits", cfg.weight_bits, 2, 24);
+  require_in_range("correlator_fixed.score_bits", cfg.score_bits, 4, 24);
+
+  CorrelatorFixedLayout l;
+  l.period = ref.period;
+  l.chip_samples = ref.chip_samples;
+  l.decimation = ref.decimation;
+  l.chips = static_cast<int>(ref.codes.front().size());
+  l.codes = static_cast<int>(ref.codes.size());
+  l.taps = static_cast<int>(ref.chip_taps.size());
+  l.window = ref.window;
+  const int int_bits = cfg.data_bits - cfg.data_frac;  // integer bits of y, sign included
+  l.mix_frac = cfg.mix_bits - int_bits;
+  l.mix_shift = cfg.data_frac + cfg.lo_bits - 1 - l.mix_frac;
+  if (l.mix_shift < 0) {
+    throw InputError("correlator_fixed.mix_bits: " + std::to_string(cfg.mix_bits) +
+                     " keeps more fraction bits than the product has; valid range is [2, " +
+                     std::to_string(cfg.data_bits + cfg.lo_bits - 1) + "]");
+  }
+  l.dec_bits = cfg.mix_bits + ceil_log2(ref.period);
+
+  // Tables: LO and taps scaled to the largest odd-symmetric code, 2^(bits-1) - 1.
+  const double lo_amp = std::exp2(cfg.lo_bits - 1) - 1.0;
+  for (int k = 0; k < ref.period; ++k) {
+    const double w = 2.0 * std::numbers::pi * k / ref.period;
+    l.lo_cos.push_back(std::llround(lo_amp * std::cos(w)));
+    l.lo_sin.push_back(std::llround(lo_amp * std::sin(w)));
+  }
+  const double tap_amp = std::exp2(cfg.tap_bits - 1) - 1.0;
+  double peak = 0;
+  for (double g : ref.chip_taps) peak = std::max(peak, std::abs(g));
+  if (peak <= 0) throw InputError("correlator: the chip template is all zero");
+  std::int64_t tap_l1 = 0;
+  for (double g : ref.chip_taps) {
+    l.taps_q.push_back(std::llround(tap_amp * g / peak));
+    tap_l1 += std::abs(l.taps_q.back());
+  }
+
+  // F: |F| <= sum |g_q| * 2^(dec_bits-1). Quantize so that bound fits chip_bits (no saturation).
+  l.fir_bits = bits_for_magnitude(static_cast<double>(tap_l1) * std::exp2(l.dec_bits - 1));
+  if (l.fir_bits > 62) throw InputError("correlator: chip filter accumulator exceeds 62 bits");
+  // F and C scale: fixed = float * 2^mix_frac * lo_amp/2^(lo_bits-1) * tap_amp/peak / 2^shift.
+  // A full-scale input (peak 1) peaks 6 dB below the top of chip_bits and corr_bits.
+  const double front = (lo_amp / std::exp2(cfg.lo_bits - 1)) * std::exp2(l.mix_frac) * (tap_amp / peak);
+  if (!(ref.chip_peak > 0) || !(ref.corr_peak > 0)) {
+    throw InputError("correlator: the reference has no chip/corr peak (design it with design_receiver)");
+  }
+  l.chip_shift = std::max(0, static_cast<int>(std::ceil(std::log2(ref.chip_peak * front))) -
+                                 (cfg.chip_bits - 2));
+  l.chip_shift = std::min(l.chip_shift, l.fir_bits);
+  l.comb_bits = cfg.chip_bits + ceil_log2(l.chips);
+  l.corr_shift = cfg.corr_shift >= 0
+                     ? cfg.corr_shift
+                     : std::max(0, static_cast<int>(std::ceil(std::log2(
+                                       ref.corr_peak * front * std::exp2(-l.chip_shift)))) -
+                                       (cfg.corr_bits - 2));
+  require_in_range("correlator_fixed.corr_shift", l.corr_shift, 0, l.comb_bits);
+  l.power_bits = 2 * cfg.corr_bits;  // Re = Im = -2^(corr_bits-1) gives P = 2^(2 corr_bits - 1)
+  l.weighted_bits = l.power_bits + cfg.weight_bits;
+  l.energy_bits = 2 * cfg.data_bits - 1 + ceil_log2(ref.window);
+  if (l.energy_bits > 63 || l.weighted_bits > 63) {
+    throw InputError("correlator: energy or weighted power exceeds 63 bits; lower "
+                     "correlator_fixed.data_bits, corr_bits or weight_bits");
+  }
+
+  // Scale from float P to fixed P: the float bank computes with the unscaled LO and taps.
+  const double amp = front * std::exp2(-(l.chip_shift + l.corr_shift));
+  const double s_p = amp * amp;
+  double max_raw = 0;
+  std::vector<double> raw;
+  for (double k : ref.code_gain) {
+    raw.push_back(std::exp2(cfg.score_bits + 2.0 * cfg.data_frac) / (k * s_p));
+    max_raw = std::max(max_raw, raw.back());
+  }
+  if (cfg.energy_shift >= 0) {
+    l.energy_shift = cfg.energy_shift;
+  } else {
+    // Largest weight in [2^(weight_bits-1), 2^weight_bits): the most precision that fits.
+    l.energy_shift = std::max(0, static_cast<int>(std::floor(std::log2(max_raw))) - (cfg.weight_bits - 1));
+  }
+  require_in_range("correlator_fixed.energy_shift", l.energy_shift, 0, l.energy_bits);
+  for (double r : raw) {
+    const double w = std::round(r * std::exp2(-l.energy_shift));
+    if (w < 1 || w >= std::exp2(cfg.weight_bits)) {
+      throw InputError("correlator_fixed.energy_shift: " + std::to_string(l.energy_shift) +
+                       " gives a code weight of " + std::to_string(w) +
+                       "; valid range keeps every weight in [1, 2^weight_bits)");
+    }
+    l.weights.push_back(static_cast<std::int64_t>(w));
+  }
+  return l;
+}
+
+std::vector<std::complex<double>> baseband_decimate(std::span<const double> x, int period,
+                                                    int decimation) {
+  std::vector<std::complex<double>> b(x.size()), out;
+  std::complex<double> acc = 0;
+  for (std::size_t n = 0; n < x.size(); ++n) {
+    const double w = 2.0 * std::numbers::pi * static_cast<double>(n % period) / period;
+    b[n] = x[n] * std::polar(1.0, -w);
+    acc += b[n];
+    if (n >= static_cast<std::size_t>(period)) acc -= b[n - period];
+    if ((n + 1) % decimation == 0) out.push_back(acc);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Float reference.
+
+CorrelatorBankFloat::CorrelatorBankFloat(const CorrelatorReference& ref)
+    : ref_(ref), chips_(static_cast<int>(ref.codes.empty() ? 0 : ref.codes.front().size())) {
+  check_reference(ref_);
+  reset();
+}
+
+void CorrelatorBankFloat::reset() {
+  n_ = 0;
+  acc_re_ = acc_im_ = energy_ = 0;
+  b_re_.assign(static_cast<std::size_t>(ref_.period), 0.0);
+  b_im_.assign(b_re_.size(), 0.0);
+  b_idx_ = 0;
+  bd_re_.assign(ref_.chip_taps.size(), 0.0);
+  bd_im_.assign(ref_.chip_taps.size(), 0.0);
+  f_re_.assign(combiner_history(ref_), 0.0);
+  f_im_.assign(f_re_.size(), 0.0);
+  y2_.assign(static_cast<std::size_t>(ref_.window), 0.0);
+  bd_idx_ = bd_re_.size() - 1;
+  f_idx_ = f_re_.size() - 1;
+  y_idx_ = y2_.size() - 1;
+  q_.assign(ref_.codes.size(), 0.0);
+}
+
+bool CorrelatorBankFloat::execute(double y) {
+  const double w = 2.0 * std::numbers::pi * static_cast<double>(n_ % ref_.period) / ref_.period;
+  const double bre = y * std::cos(w), bim = -y * std::sin(w);
+  acc_re_ += bre - b_re_[b_idx_];
+  acc_im_ += bim - b_im_[b_idx_];
+  b_re_[b_idx_] = bre;
+  b_im_[b_idx_] = bim;
+  b_idx_ = (b_idx_ + 1) % b_re_.size();
+  y_idx_ = (y_idx_ + 1) % y2_.size();
+  energy_ += y * y - y2_[y_idx_];
+  y2_[y_idx_] = y * y;
+  energy_ = std::max(energy_, 0.0);  // running-sum rounding in double
+  ++n_;
+  if (n_ % ref_.decimation != 0) return false;
+
+  bd_idx_ = (bd_idx_ + 1) % bd_re_.size();
+  bd_re_[bd_idx_] = acc_re_;
+  bd_im_[bd_idx_] = acc_im_;
+  double fre = 0, fim = 0;
+  const std::size_t m = bd_re_.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::size_t k = (bd_idx_ + m - i) % m;
+    fre += ref_.chip_taps[i] * bd_re_[k];
+    fim += ref_.chip_taps[i] * bd_im_[k];
+  }
+  f_idx_ = (f_idx_ + 1) % f_re_.size();
+  f_re_[f_idx_] = fre;
+  f_im_[f_idx_] = fim;
+  chip_mag_ = std::hypot(fre, fim);
+  corr_mag_ = 0;
+
+  const std::size_t fn = f_re_.size();
+  const std::size_t step = static_cast<std::size_t>(ref_.chip_samples / ref_.decimation);
+  for (std::size_t j = 0; j < q_.size(); ++j) {
+    double cre = 0, cim = 0;
+    for (int c = 0; c < chips_; ++c) {
+      const std::size_t k = (f_idx_ + fn - static_cast<std::size_t>(chips_ - 1 - c) * step) % fn;
+      const double s = ref_.codes[j][c] ? 1.0 : -1.0;
+      cre += s * f_re_[k];
+      cim += s * f_im_[k];
+    }
+    q_[j] = (cre * cre + cim * cim) / ref_.code_gain[j];
+    corr_mag_ = std::max(corr_mag_, std::hypot(cre, cim));
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------
+// Bit-accurate model.
+
+CorrelatorBankFixed::CorrelatorBankFixed(const CorrelatorReference& ref,
+                                         const CorrelatorFixedConfig& cfg)
+    : cfg_(cfg), layout_(resolve_correlator_layout(ref, cfg)), signs_(code_signs(ref.codes)) {
+  mix_fmt_ = FixedFormat{cfg.mix_bits, layout_.mix_frac, true, Rounding::RoundHalfUp, Overflow::Saturate};
+  chip_fmt_ = FixedFormat{cfg.chip_bits, 0, true, Rounding::RoundHalfUp, Overflow::Saturate};
+  corr_fmt_ = FixedFormat{cfg.corr_bits, 0, true, Rounding::RoundHalfUp, Overflow::Saturate};
+  reset();
+}
+
+void CorrelatorBankFixed::reset() {
+  const auto& l = layout_;
+  n_ = 0;
+  phase_ = 0;
+  mix_re_ = mix_im_ = acc_re_ = acc_im_ = 0;
+  b_re_.assign(static_cast<std::size_t>(l.period), 0);
+  b_im_.assign(b_re_.size(), 0);
+  b_idx_ = 0;
+  bd_re_.assign(l.taps, 0);
+  bd_im_.assign(l.taps, 0);
+  f_re_.assign(static_cast<std::size_t>(l.chips - 1) * (l.chip_samples / l.decimation) + 1, 0);
+  f_im_.assign(f_re_.size(), 0);
+  y2_.assign(static_cast<std::size_t>(l.window), 0);
+  bd_idx_ = bd_re_.size() - 1;
+  f_idx_ = f_re_.size() - 1;
+  y_idx_ = y2_.size() - 1;
+  energy_ = 0;
+  corr_re_.assign(l.codes, 0);
+  corr_im_.assign(l.codes, 0);
+  p_.assign(l.codes, 0);
+  q_.assign(l.codes, 0);
+  counter_ = {};
+}
+
+bool CorrelatorBankFixed::execute(std::int64_t y) {
+  const auto& l = layout_;
+  // 1. mixer: exact product, round half up into the mixer format.
+  const int product_frac = cfg_.data_frac + cfg_.lo_bits - 1;
+  mix_re_ = fx_quantize(static_cast<int128_t>(y) * l.lo_cos[phase_], product_frac, mix_fmt_, &counter_);
+  mix_im_ = fx_quantize(-static_cast<int128_t>(y) * l.lo_sin[phase_], product_frac, mix_fmt_, &counter_);
+  phase_ = (phase_ + 1) % l.period;
+  // 2. moving sum over one carrier cycle (exact; dec_bits hold it).
+  acc_re_ += mix_re_ - b_re_[b_idx_];
+  acc_im_ += mix_im_ - b_im_[b_idx_];
+  b_re_[b_idx_] = mix_re_;
+  b_im_[b_idx_] = mix_im_;
+  b_idx_ = (b_idx_ + 1) % b_re_.size();
+  // 7. energy: running sum of y^2 over the window, exact (unsigned, wraps never: width holds it).
+  y_idx_ = (y_idx_ + 1) % y2_.size();
+  const std::uint64_t y2 = static_cast<std::uint64_t>(y * y);
+  energy_ = energy_ + y2 - y2_[y_idx_];
+  y2_[y_idx_] = y2;
+  ++n_;
+  if (n_ % l.decimation != 0) return false;
+
+  // decimator output: every D-th moving sum.
+  bd_idx_ = (bd_idx_ + 1) % bd_re_.size();
+  bd_re_[bd_idx_] = acc_re_;
+  bd_im_[bd_idx_] = acc_im_;
+  // 3. chip filter: exact accumulation, then round half up by chip_shift (bound fits).
+  std::int64_t fre = 0, fim = 0;
+  const std::size_t m = bd_re_.size();
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::size_t k = (bd_idx_ + m - i) % m;
+    fre += l.taps_q[i] * bd_re_[k];
+    fim += l.taps_q[i] * bd_im_[k];
+  }
+  f_idx_ = (f_idx_ + 1) % f_re_.size();
+  f_re_[f_idx_] = fx_quantize(fre, l.chip_shift, chip_fmt_, &counter_);
+  f_im_[f_idx_] = fx_quantize(fim, l.chip_shift, chip_fmt_, &counter_);
+
+  // 4-6. combiner (exact), quantize, power, weight.
+  const std::size_t fn = f_re_.size();
+  const std::size_t step = static_cast<std::size_t>(l.chip_samples / l.decimation);
+  for (std::size_t j = 0; j < signs_.size(); ++j) {
+    std::int64_t cre = 0, cim = 0;
+    for (int c = 0; c < l.chips; ++c) {
+      const std::size_t k = (f_idx_ + fn - static_cast<std::size_t>(l.chips - 1 - c) * step) % fn;
+      cre += signs_[j][c] * f_re_[k];
+      cim += signs_[j][c] * f_im_[k];
+    }
+    corr_re_[j] = fx_quantize(cre, l.corr_shift, corr_fmt_, &counter_);
+    corr_im_[j] = fx_quantize(cim, l.corr_shift, corr_fmt_, &counter_);
+    p_[j] = static_cast<std::uint64_t>(corr_re_[j] * corr_re_[j] + corr_im_[j] * corr_im_[j]);
+    q_[j] = p_[j] * static_cast<std::uint64_t>(l.weights[j]);
+  }
+  return true;
+}
+
+}  // namespace ranging

@@ -1,0 +1,182 @@
+#pragma once
+// Parallel matched-filter bank (architecture "baseband", docs/architecture.md).
+//
+// Every code of the family is correlated on every decimated sample. A direct full-rate FIR per
+// code (9 codes x ~900 taps at 5 MS/s = 40 GMAC/s) cannot fit a small FPGA, so the matched
+// filter to the received burst of code j, sum_m c_j(m) h(n - m Nc) with h the received
+// response to one chip, is factored into stages shared by all codes:
+//
+//   1. mixer        B[n]  = y[n] exp(-j 2 pi n / P)            P = fs/f samples per carrier cycle
+//   2. decimator    Bd[k] = sum_{i<P} B[kD + D-1 - i]           one carrier cycle of B, every D-th
+//                   (a moving sum over exactly one cycle cancels the mixer's 2f image exactly)
+//   3. chip filter  F[k]  = sum_{i<M} g[i] Bd[k-i]              g: the chip template, time reversed
+//   4. combiner     C_j[k] = sum_m c_j(m) F[k - (L-1-m) Nc/D]   c = +1 for chip 1, -1 for chip 0
+//   5. power        P_j[k] = |C_j[k]|^2
+//   6. weight       Q_j[k] = P_j[k] w_j                         w_j = 1 / (P/E of code j's own template)
+//   7. energy       E[n]  = sum_{i<W} y[n-i]^2                  over the template span W
+// so rho_j^2 = Q_j / E is 1 when the input is exactly code j's template (any amplitude), and by
+// Cauchy-Schwarz no other code's template reaches it: argmax_j Q_j is the matched-filter
+// decision. The combiner taps are one chip apart and shared, so a code costs L adds, not a FIR.
+//
+// CorrelatorBankFloat computes this in double; CorrelatorBankFixed is the bit-accurate model
+// of the hardware: every node's width, rounding and overflow is in CorrelatorFixedLayout.
+#include <complex>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "model/dsp/fixed_point.hpp"
+
+namespace ranging {
+
+// What the bank correlates against, derived by the receiver design (receiver.hpp) from the
+// configuration: the chip template and every code's normalization.
+struct CorrelatorReference {
+  int period = 25;              // P = fs / f
+  int chip_samples = 100;       // Nc = q fs / f
+  int decimation = 5;           // D, divides Nc
+  int window = 900;             // W: energy window (the template span), samples
+  std::vector<double> chip_taps;          // g[i], i < M (real, peak 1)
+  std::vector<std::vector<std::uint8_t>> codes;  // chips 0/1, all of length L
+  std::vector<double> code_gain;          // K_j = P_j / E at code j's template peak (float)
+  // Largest |F| and |C_j| (float bank) over all code templates, per unit peak input amplitude:
+  // they place a full-scale input 6 dB below the top of the fixed chip and corr words.
+  double chip_peak = 0, corr_peak = 0;
+};
+
+// Word lengths of the fixed-point bank. Input y is signed data_bits with data_frac fraction bits.
+struct CorrelatorFixedConfig {
+  int data_bits = 16, data_frac = 14;  // input y (the bandpass output, Q2.14)
+  int lo_bits = 16;                    // LO table: round((2^(lo_bits-1)-1) cos|sin), signed
+  int mix_bits = 18;                   // mixer output B: same integer bits as y; round half up,
+                                       //   saturate (cannot trigger; counted)
+  int tap_bits = 16;                   // chip template taps: signed, tap_bits-1 fraction bits
+  int chip_bits = 20;                  // F quantized: round half up of F / 2^chip_shift,
+                                       //   saturate (counted); a full-scale template peaks
+                                       //   6 dB below the top
+  int corr_bits = 16;                  // C_j quantized for squaring: round half up of
+                                       //   C / 2^corr_shift, saturate (counted)
+  int corr_shift = -1;                 // -1: automatic (a full-scale template peaks 6 dB
+                                       //   below the top of corr_bits)
+  int weight_bits = 16;                // w_j: unsigned, normalized per code
+  int energy_shift = -1;               // norm = E >> energy_shift (truncate); -1: automatic
+  int score_bits = 16;                 // rho^2 as an unsigned score_bits fraction
+};
+
+// Derived, fully resolved sizes, shifts and constants (what the generator emits).
+struct CorrelatorFixedLayout {
+  int period = 0, chip_samples = 0, decimation = 0, chips = 0, codes = 0, taps = 0, window = 0;
+  int mix_frac = 0;        // fraction bits of B
+  int mix_shift = 0;       // product (data_frac + lo_bits - 1 fraction bits) >> mix_shift -> B
+  int dec_bits = 0;        // Bd: mix_bits + ceil(log2 P), exact
+  int fir_bits = 0;        // F before quantization: exact bound of sum |g_q| |Bd| (the
+                           //   accumulator width; it cannot overflow)
+  int chip_shift = 0;      // F_q = round(F / 2^chip_shift), chip_bits wide
+  int comb_bits = 0;       // C: chip_bits + ceil(log2 L), exact
+  int corr_shift = 0;      // C_q = round(C / 2^corr_shift), corr_bits wide
+  int power_bits = 0;      // P: 2 corr_bits, unsigned, exact (holds 2 (2^(corr_bits-1))^2)
+  int weighted_bits = 0;   // Q = P w: power_bits + weight_bits, unsigned, exact
+  int energy_bits = 0;     // E: 2 data_bits - 1 + ceil(log2 W), unsigned, exact
+  int energy_shift = 0;    // norm = E >> energy_shift
+  std::vector<std::int64_t> lo_cos, lo_sin;  // P entries each
+  std::vector<std::int64_t> taps_q;          // M chip template taps
+  std::vector<std::int64_t> weights;         // w_j, one per code
+};
+
+// score = min(2^score_bits - 1, floor(Q / max(norm, 1))): rho^2 as a score_bits fraction.
+std::uint64_t correlation_score(std::uint64_t weighted_power, std::uint64_t norm, int score_bits);
+
+class CorrelatorBankFloat {
+ public:
+  explicit CorrelatorBankFloat(const CorrelatorReference& ref);
+  void reset();
+  // Feeds one filtered sample. Returns true when a decimated output was produced; then
+  // weighted_power() and energy() hold its values.
+  bool execute(double y);
+  const std::vector<double>& weighted_power() const { return q_; }  // Q_j = P_j / K_j
+  double energy() const { return energy_; }
+  double rho2(int code) const { return energy_ > 0 ? q_.at(code) / energy_ : 0.0; }
+  double chip_magnitude() const { return chip_mag_; }  // |F| of the last output
+  double max_corr_magnitude() const { return corr_mag_; }  // max_j |C_j| of the last output
+  std::int64_t sample_index() const { return n_ - 1; }  // full-rate index of the last input
+  int codes() const { return static_cast<int>(q_.size()); }
+  const CorrelatorReference& reference() const { return ref_; }
+
+ private:
+  CorrelatorReference ref_;
+  int chips_;
+  std::int64_t n_ = 0;
+  double acc_re_ = 0, acc_im_ = 0;             // moving sum of B over one carrier cycle
+  std::vector<double> b_re_, b_im_;            // B history, P long
+  std::size_t b_idx_ = 0;
+  std::vector<double> bd_re_, bd_im_;          // Bd history, M long
+  std::vector<double> f_re_, f_im_;            // F history, (L-1) Nc/D + 1 long
+  std::vector<double> y2_;                     // y^2 history, W long
+  std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0;
+  double energy_ = 0, chip_mag_ = 0, corr_mag_ = 0;
+  std::vector<double> q_;
+};
+
+class CorrelatorBankFixed {
+ public:
+  // The reference's float taps and gains are quantized here (layout); bad widths throw InputError.
+  CorrelatorBankFixed(const CorrelatorReference& ref, const CorrelatorFixedConfig& cfg);
+  void reset();
+  // Feeds one filtered sample (signed data_bits integer). Returns true on a decimated output.
+  bool execute(std::int64_t y);
+
+  // Stage taps of the last decimated output, for stage-by-stage comparison with the hardware.
+  std::int64_t mix_re() const { return mix_re_; }  // last full-rate mixer output
+  std::int64_t mix_im() const { return mix_im_; }
+  std::int64_t dec_re() const { return bd_re_[bd_idx_]; }
+  std::int64_t dec_im() const { return bd_im_[bd_idx_]; }
+  std::int64_t chip_re() const { return f_re_[f_idx_]; }  // F_q
+  std::int64_t chip_im() const { return f_im_[f_idx_]; }
+  const std::vector<std::int64_t>& corr_re() const { return corr_re_; }  // C_q per code
+  const std::vector<std::int64_t>& corr_im() const { return corr_im_; }
+  const std::vector<std::uint64_t>& power() const { return p_; }           // P_j
+  const std::vector<std::uint64_t>& weighted_power() const { return q_; }  // Q_j
+  std::uint64_t energy() const { return energy_; }                         // E, exact
+  std::uint64_t norm() const { return energy_ >> layout_.energy_shift; }
+  std::uint64_t score(int code) const {
+    return correlation_score(q_.at(code), norm(), cfg_.score_bits);
+  }
+  std::int64_t sample_index() const { return n_ - 1; }
+
+  const CorrelatorFixedLayout& layout() const { return layout_; }
+  const CorrelatorFixedConfig& config() const { return cfg_; }
+  OverflowCounter overflow_events() const { return counter_; }
+  int codes() const { return static_cast<int>(q_.size()); }
+
+ private:
+  CorrelatorFixedConfig cfg_;
+  CorrelatorFixedLayout layout_;
+  std::vector<std::vector<int>> signs_;
+  FixedFormat mix_fmt_, chip_fmt_, corr_fmt_;
+  std::int64_t n_ = 0;
+  int phase_ = 0;
+  std::int64_t mix_re_ = 0, mix_im_ = 0, acc_re_ = 0, acc_im_ = 0;
+  std::vector<std::int64_t> b_re_, b_im_;  // B history, P long
+  std::size_t b_idx_ = 0;
+  std::vector<std::int64_t> bd_re_, bd_im_, f_re_, f_im_;
+  std::vector<std::uint64_t> y2_;
+  std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0;
+  std::uint64_t energy_ = 0;
+  std::vector<std::int64_t> corr_re_, corr_im_;
+  std::vector<std::uint64_t> p_, q_;
+  OverflowCounter counter_;
+};
+
+// The float front end (mixer + one-cycle moving sum + decimation by D) applied to a whole
+// signal from rest: what the bank's chip filter sees. Used to derive the chip template.
+std::vector<std::complex<double>> baseband_decimate(std::span<const double> x, int period,
+                                                    int decimation);
+
+// Resolve the layout: widths from the bounds of every node, the LO table, the quantized taps
+// and the per-code weights w_j = 2^(score_bits + 2 data_frac - energy_shift) / (K_j s_P), where
+// s_P is the exact scale from float P to fixed P, so that score = Q / norm = rho^2 2^score_bits.
+// Throws InputError naming the field when a width cannot hold its bound.
+CorrelatorFixedLayout resolve_correlator_layout(const CorrelatorReference& ref,
+                                                const CorrelatorFixedConfig& cfg);
+
+}  // namespace ranging

@@ -1,0 +1,181 @@
+#include "model/dsp/peak_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "model/base/error.hpp"
+
+namespace ranging {
+namespace {
+
+template <class T>
+void best_two(const std::vector<T>& q, int& best, T& second) {
+  best = 0;
+  for (int j = 1; j < static_cast<int>(q.size()); ++j) {
+    if (q[j] > q[best]) best = j;
+  }
+  second = T{};
+  for (int j = 0; j < static_cast<int>(q.size()); ++j) {
+    if (j != best && q[j] > second) second = q[j];
+  }
+}
+
+}  // namespace
+
+void validate(const DetectorConfig& cfg) {
+  require_in_range("detector.threshold", cfg.threshold, 0.0, 1.0);
+  require_in_range("detector.min_energy", cfg.min_energy, 0.0, 1e12);
+  require_in_range("detector.frac_bits", cfg.frac_bits, 0, 16);
+  if (cfg.holdoff != -1) require_in_range("detector.holdoff", cfg.holdoff, 1, 1 << 24);
+}
+
+Event EventFixed::to_float(int frac_bits, int score_bits) const {
+  Event e;
+  e.code = code;
+  e.arrival = std::ldexp(static_cast<double>(arrival), -frac_bits);
+  e.score = std::ldexp(static_cast<double>(score), -score_bits);
+  e.margin = std::ldexp(static_cast<double>(margin), -score_bits);
+  return e;
+}
+
+std::int64_t parabolic_fraction(std::uint64_t q_prev, std::uint64_t q, std::uint64_t q_next,
+                                int frac_bits) {
+  const int128_t den = 2 * (2 * static_cast<int128_t>(q) - q_prev - q_next);
+  if (den <= 0) return 0;
+  const int128_t num = (static_cast<int128_t>(q_next) - q_prev) * (int128_t{1} << frac_bits);
+  const std::int64_t half = frac_bits > 0 ? (std::int64_t{1} << (frac_bits - 1)) : 0;
+  const int128_t r = num / den;  // truncates toward zero
+  return static_cast<std::int64_t>(std::clamp<int128_t>(r, -half, half));
+}
+
+// ---------------------------------------------------------------------------------------
+
+PeakDetectorFloat::PeakDetectorFloat(const DetectorConfig& cfg, const CorrelatorReference& ref)
+    : cfg_(cfg), holdoff_(cfg.holdoff == -1 ? ref.window : cfg.holdoff), decimation_(ref.decimation) {
+  validate(cfg);
+}
+
+void PeakDetectorFloat::reset() {
+  prev_.clear();
+  cand_.reset();
+}
+
+Event PeakDetectorFloat::make_event(const Candidate& c) const {
+  Event e;
+  e.code = c.code + 1;
+  const double den = 2.0 * (2.0 * c.q - c.q_prev - c.q_next);
+  const double delta = den > 0 ? std::clamp((c.q_next - c.q_prev) / den, -0.5, 0.5) : 0.0;
+  e.arrival = static_cast<double>(c.n) + decimation_ * delta;
+  e.score = c.score;
+  e.margin = c.margin;
+  return e;
+}
+
+std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank) {
+  const std::vector<double>& q = bank.weighted_power();
+  if (prev_.empty()) prev_.assign(q.size(), 0.0);
+  std::optional<Event> out;
+  int best;
+  double second;
+  best_two(q, best, second);
+  if (cand_ && !cand_->has_next) {
+    cand_->q_next = q[cand_->code];
+    cand_->has_next = true;
+  }
+  const std::int64_t n = bank.sample_index();
+  const double rho2 = bank.rho2(best);
+  const bool gate = rho2 >= cfg_.threshold && bank.energy() >= cfg_.min_energy;
+  if (gate && (!cand_ || rho2 > cand_->score)) {
+    const double margin = rho2 - (bank.energy() > 0 ? second / bank.energy() : 0.0);
+    cand_ = Candidate{n, best, prev_[best], q[best], 0.0, rho2, margin, false};
+  } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
+    out = make_event(*cand_);
+    cand_.reset();
+  }
+  prev_ = q;
+  return out;
+}
+
+std::optional<Event> PeakDetectorFloat::flush() {
+  std::optional<Event> out;
+  if (cand_) {
+    if (!cand_->has_next) cand_->q_next = cand_->q_prev;  // no right neighbour: symmetric
+    out = make_event(*cand_);
+    cand_.reset();
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+
+PeakDetectorFixed::PeakDetectorFixed(const DetectorConfig& cfg, const CorrelatorFixedLayout& layout,
+                                     const CorrelatorFixedConfig& corr)
+    : cfg_(cfg),
+      score_bits_(corr.score_bits),
+      decimation_(layout.decimation),
+      holdoff_(cfg.holdoff == -1 ? layout.window : cfg.holdoff) {
+  validate(cfg);
+  const std::uint64_t cap = (std::uint64_t{1} << score_bits_) - 1;
+  thr_q_ = std::min<std::uint64_t>(
+      cap, static_cast<std::uint64_t>(std::llround(std::ldexp(cfg.threshold, score_bits_))));
+  // min_energy is in full-scale units^2: E_raw = E 2^(2 data_frac); norm = E_raw >> shift.
+  const double e_raw = std::ldexp(cfg.min_energy, 2 * corr.data_frac - layout.energy_shift);
+  require_in_range("detector.min_energy (in norm units)", e_raw, 0.0, 9.0e18);
+  min_norm_ = static_cast<std::uint64_t>(std::ceil(e_raw));
+}
+
+void PeakDetectorFixed::reset() {
+  prev_.clear();
+  cand_.reset();
+}
+
+EventFixed PeakDetectorFixed::make_event(const Candidate& c) const {
+  EventFixed e;
+  e.code = c.code + 1;
+  e.arrival = c.n * (std::int64_t{1} << cfg_.frac_bits) +
+              decimation_ * parabolic_fraction(c.q_prev, c.q, c.q_next, cfg_.frac_bits);
+  e.score = correlation_score(c.q, c.norm, score_bits_);
+  e.margin = e.score - correlation_score(c.q_second, c.norm, score_bits_);
+  return e;
+}
+
+std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& bank) {
+  const std::vector<std::uint64_t>& q = bank.weighted_power();
+  if (prev_.empty()) prev_.assign(q.size(), 0);
+  std::optional<EventFixed> out;
+  int best;
+  std::uint64_t second;
+  best_two(q, best, second);
+  if (cand_ && !cand_->has_next) {
+    cand_->q_next = q[cand_->code];
+    cand_->has_next = true;
+  }
+  const std::int64_t n = bank.sample_index();
+  const std::uint64_t norm = bank.norm();
+  const bool gate = static_cast<uint128_t>(q[best]) >=
+                        static_cast<uint128_t>(thr_q_) * std::max<std::uint64_t>(norm, 1) &&
+                    norm >= min_norm_;
+  // rho^2 of the best code beats the candidate's: Q / norm > Q_c / norm_c, cross-multiplied.
+  const bool better = !cand_ || static_cast<uint128_t>(q[best]) * std::max<std::uint64_t>(cand_->norm, 1) >
+                                    static_cast<uint128_t>(cand_->q) * std::max<std::uint64_t>(norm, 1);
+  if (gate && better) {
+    cand_ = Candidate{n, best, prev_[best], q[best], 0, second, norm, false};
+  } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
+    out = make_event(*cand_);
+    cand_.reset();
+  }
+  prev_ = q;
+  return out;
+}
+
+std::optional<EventFixed> PeakDetectorFixed::flush() {
+  std::optional<EventFixed> out;
+  if (cand_) {
+    if (!cand_->has_next) cand_->q_next = cand_->q_prev;  // no right neighbour: symmetric
+    out = make_event(*cand_);
+    cand_.reset();
+  }
+  return out;
+}
+
+}  // namespace ranging

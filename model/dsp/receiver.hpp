@@ -1,0 +1,117 @@
+#pragma once
+// The receiver: bandpass filter -> parallel correlator bank -> peak detector, in two
+// precisions with one life cycle (create / execute / reset / flush):
+//   ReceiverFloat  double-precision reference of the same structure
+//   ReceiverFixed  the bit-accurate model the generated HLS C++ and Verilog implement
+// Both are built from one ReceiverConfig (configs/*.yaml), the single source of truth.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/dsp/bandpass_filter.hpp"
+#include "model/dsp/codes.hpp"
+#include "model/dsp/correlator_bank.hpp"
+#include "model/dsp/filter_design.hpp"
+#include "model/dsp/peak_detector.hpp"
+#include "model/dsp/transducer.hpp"
+
+namespace ranging {
+
+struct ReceiverConfig {
+  std::string name = "default";
+  std::string family = "Gold4";          // code family (ranging codes --list)
+  std::string architecture = "baseband"; // matched-filter architecture (docs/architecture.md)
+  double carrier_hz = 200e3;             // f
+  int cycles_per_chip = 4;               // q
+  double fs = 5e6;                       // ADC sample rate
+  BandpassSpec filter;                   // the paper's 150-250 kHz spec by default
+  FilterType filter_type = FilterType::Butterworth;
+  int filter_order = 0;                  // 0: the minimum order for the spec
+  // Matched-filter reference (docs/architecture.md): "received" matches the response of the
+  // transducers and the bandpass filter to one chip, as the paper's received templates do;
+  // "ideal" matches the bare BPSK excitation.
+  std::string reference = "received";
+  TransducerParams reference_transducer;  // TX and RX of the template (received mode)
+  int decimation = 20;                   // D: the bank runs at fs / D
+  double template_floor = 0.1;           // template tail trimmed below this fraction of its
+                                         // peak (the paper's T_d threshold, b/10)
+  BandpassFixedConfig bandpass;          // fixed-point word lengths of the filter
+  CorrelatorFixedConfig correlator;      // ... of the correlator bank
+  DetectorConfig detector;
+  // hardware.clock_hz: the system clock the generated RTL is scheduled for (the iCEBreaker's
+  // PLL makes it from 12 MHz); clock_hz / fs clocks per input sample, an integer.
+  double clock_hz = 30e6;
+
+  int period() const;        // fs / f, samples per carrier cycle (validated integer)
+  int chip_samples() const;  // q fs / f
+  int sample_cycles() const; // clock_hz / fs (validated integer)
+};
+
+// Throws InputError naming the field and valid range.
+void validate(const ReceiverConfig& cfg);
+
+// Lowers cfg.decimation to the largest divisor of the samples per chip that does not exceed it
+// (scenes whose families use another q than the configuration's, e.g. M3/M4 at q = 2 with the
+// default D = 20 -> 10). No-op when it already divides or fs is unset.
+void fit_decimation_to_chip(ReceiverConfig& cfg);
+
+// Everything derived from a configuration: codes, filter, layouts.
+struct ReceiverDesign {
+  ReceiverConfig config;
+  CodeFamily family;
+  SosFilter filter;
+  CorrelatorReference reference;          // chip template, energy window, code gains
+  std::vector<std::vector<double>> templates;  // full-rate template of every code (what
+                                               // the bank is matched to), for reports
+  CorrelatorFixedLayout layout;
+};
+ReceiverDesign design_receiver(const ReceiverConfig& cfg);
+
+// ADC model: x in full-scale units -> signed `bits` integer, round half up, saturate (counted).
+std::int64_t quantize_input(double x, int bits, OverflowCounter* counter);
+
+class ReceiverFloat {
+ public:
+  explicit ReceiverFloat(const ReceiverDesign& design);
+  void reset();
+  std::optional<Event> execute(double x);
+  std::optional<Event> flush() { return detector_.flush(); }
+  double filtered() const { return filtered_; }  // last bandpass output
+  const CorrelatorBankFloat& bank() const { return bank_; }
+
+ private:
+  BandpassFloat filter_;
+  CorrelatorBankFloat bank_;
+  PeakDetectorFloat detector_;
+  double filtered_ = 0;
+};
+
+class ReceiverFixed {
+ public:
+  explicit ReceiverFixed(const ReceiverDesign& design);
+  void reset();
+  // x: signed input_bits ADC code.
+  std::optional<EventFixed> execute_raw(std::int64_t x);
+  // x in full-scale units: quantized by quantize_input first; the event in float form.
+  std::optional<Event> execute(double x);
+  std::optional<EventFixed> flush_raw() { return detector_.flush(); }
+  std::optional<Event> flush();
+
+  std::int64_t filtered() const { return filtered_; }  // last bandpass output (data format)
+  const BandpassFixed& filter() const { return filter_; }
+  const CorrelatorBankFixed& bank() const { return bank_; }
+  const PeakDetectorFixed& detector() const { return detector_; }
+  OverflowCounter overflow_events() const;  // input + filter + correlator
+  Event to_float(const EventFixed& e) const;
+
+ private:
+  int input_bits_, frac_bits_, score_bits_;
+  BandpassFixed filter_;
+  CorrelatorBankFixed bank_;
+  PeakDetectorFixed detector_;
+  std::int64_t filtered_ = 0;
+  OverflowCounter input_counter_;
+};
+
+}  // namespace ranging

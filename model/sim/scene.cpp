@@ -1,0 +1,232 @@
+#include "model/config/receiver_config.hpp"
+#include "model/sim/scene.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "model/dsp/codes.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/config/yaml_reader.hpp"
+
+namespace ranging {
+
+double Scene::speed() const {
+  if (medium.speed_of_sound) return *medium.speed_of_sound;
+  if (medium.air) return speed_of_sound(*medium.air);
+  return 340.0;  // the paper's value
+}
+
+double Scene::range_l() const {
+  if (max_range_m > 0) return max_range_m;
+  double l = 0;
+  for (double d : geometry.distances_m) l = std::max(l, d);
+  return l;
+}
+
+namespace {
+
+using yaml::Reader;
+using yaml::one_of;
+using yaml::section;
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& origin, const std::string& base_dir) {
+  YAML::Node root = yaml::load(text, origin);
+  if (!root || root.IsNull()) throw InputError(origin + ": the scene is empty (it needs at least geometry.distances_m)");
+  Scene s;
+  s.origin = origin;
+  Reader top(root, origin, "");
+  top.get("name", s.name);
+  top.get_range("max_range_m", s.max_range_m, 0.0, 1000.0);
+  top.get_range("sample_rate", s.fs, 1e4, 1e9);
+
+  section(top, "medium", [&](Reader& r) {
+    AirConditions a;
+    bool any = false;
+    any |= r.get_range("temperature_c", a.temperature_c, -40, 60);
+    any |= r.get_range("relative_humidity", a.relative_humidity, 0, 100);
+    any |= r.get_range("pressure_kpa", a.pressure_kpa, 50, 120);
+    if (any) s.medium.air = a;
+    double c = 0;
+    if (r.get_range("speed_of_sound", c, 100, 10000)) s.medium.speed_of_sound = c;
+  });
+
+  bool has_sensitivity = false;
+  section(top, "transducers", [&](Reader& r) {
+    auto& t = s.transducers;
+    t.named = true;
+    r.get_range("centre_hz", t.centre_hz, 1e3, 10e6);
+    const bool q = r.get_range("q", t.q, 0.1, 1000);
+    double bw = 0;
+    if (r.get_range("bandwidth_hz", bw, 1.0, 10e6)) {
+      if (q) r.error("bandwidth_hz", "give q or bandwidth_hz, not both");
+      t.q = t.centre_hz / bw;
+      r.check("bandwidth_hz", t.q, 0.1, 1000);
+    }
+    r.get_range("beam_angle_deg", t.beam_angle_deg, 0.5, 170);
+    has_sensitivity = r.get_range("sensitivity", s.sensitivity, 1e-9, 1e3);
+  });
+  (void)has_sensitivity;
+
+  if (!section(top, "geometry", [&](Reader& r) {
+        r.get("type", s.geometry.type);
+        if (s.geometry.type == "moving") r.error("type", "'moving' geometry is not implemented yet (a later issue); valid: static");
+        one_of(r, "type", s.geometry.type, {"static"});
+        if (!r.get_list("distances_m", s.geometry.distances_m) || s.geometry.distances_m.empty()) {
+          r.error("distances_m", "give at least one distance (metres)");
+        }
+        for (std::size_t i = 0; i < s.geometry.distances_m.size(); ++i) {
+          r.check("distances_m", s.geometry.distances_m[i], 0.01, 20.0);
+        }
+        r.get_range("repeats", s.geometry.repeats, 1, 100000);
+        double a = 0;
+        if (r.get_range("angle_deg", a, 0, 89)) s.geometry.angle_deg = a;
+      })) {
+    throw InputError(origin + ": geometry: missing; a scene needs at least geometry.distances_m");
+  }
+
+  section(top, "excitation", [&](Reader& r) {
+    auto& e = s.excitation;
+    if (r.has("family")) {
+      const YAML::Node f = r.node("family");
+      if (f.IsSequence()) {
+        r.get_list("family", e.families);
+      } else {
+        std::string one;
+        r.get("family", one);
+        e.families = {one};
+      }
+      if (e.families.empty()) r.error("family", "give at least one code family");
+      for (const auto& name : e.families) {
+        try {
+          (void)code_family(name);
+        } catch (const InputError& err) {
+          r.error("family", err.what());
+        }
+      }
+    } else {
+      r.child("family");
+    }
+    r.get_range("cycles_per_chip", e.cycles_per_chip, 1, 64);
+    r.get_range("carrier_hz", e.carrier_hz, 1e3, 10e6);
+    section(r, "cycles_per_chip_by_family", [&](Reader& q) {
+      // Any family name (a family the scene does not send is harmless); others are unknown keys.
+      for (const auto& name : code_family_names()) {
+        int v = 0;
+        if (q.get_range(name, v, 1, 64)) e.cycles_per_chip_by_family[name] = v;
+      }
+    });
+    r.get_range("drive_vpp", e.drive_vpp, 1e-6, 1e4);
+    r.get_range("amplifier_gain", e.amplifier_gain, 1e-6, 1e4);
+    if (r.get_list("codes", e.codes)) {
+      for (int j : e.codes) {
+        for (const auto& name : e.families) {
+          const int eta = code_family(name).eta();
+          if (j < 1 || j > eta) {
+            r.error("codes", std::to_string(j) + " is out of range; family " + name + " has codes 1.." + std::to_string(eta));
+          }
+        }
+      }
+    }
+    section(r, "schedule", [&](Reader& q) {
+      q.get("mode", e.schedule.mode);
+      one_of(q, "mode", e.schedule.mode, {"single", "periodic"});
+      q.get_range("period_s", e.schedule.period_s, 1e-6, 10.0);
+      q.get_range("bursts", e.schedule.bursts, 0, 10000);
+      if (e.schedule.mode == "periodic" && e.schedule.period_s <= 0) q.error("period_s", "periodic mode needs period_s");
+    });
+  });
+
+  section(top, "noise", [&](Reader& r) {
+    auto& n = s.noise;
+    n.named = true;
+    double v = 0;
+    if (r.get_range("snr_db", v, -40, 200)) n.snr_db = v;
+    if (r.get_range("noise_v", v, 0, 1e3)) {
+      if (n.snr_db) r.error("noise_v", "give snr_db or noise_v, not both");
+      n.noise_v = v;
+    }
+    long long seed = 1;
+    if (r.get_range("seed", seed, 0, 9.0e18)) n.seed = static_cast<std::uint64_t>(seed);
+    section(r, "adc", [&](Reader& a) {
+      SceneAdc adc;
+      a.get_range("bits", adc.bits, 2, 24);
+      a.get_range("full_scale_v", adc.full_scale_v, 1e-6, 1e4);
+      a.get_range("sample_rate", s.fs, 1e4, 1e9);
+      n.adc = adc;
+    });
+  });
+
+  section(top, "receiver", [&](Reader& r) {
+    auto& rc = s.receiver;
+    std::string cfg;
+    if (r.get("config", cfg)) {
+      std::filesystem::path p(cfg);
+      if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
+      rc.config = load_receiver_config(p.string());
+    }
+    std::string type;
+    if (r.get("filter_type", type)) {
+      try {
+        rc.config.filter_type = parse_filter_type(type);
+      } catch (const InputError&) {
+        r.error("filter_type", "'" + type + "' is not valid; valid: butter, cheby1, ellip");
+      }
+    }
+    r.get_range("filter_order", rc.config.filter_order, 0, 20);
+    r.get_range("threshold", rc.config.detector.threshold, 0, 1);
+    r.get("precision", rc.precision);
+    one_of(r, "precision", rc.precision, {"float", "fixed"});
+    r.get("reference", rc.reference);
+    one_of(r, "reference", rc.reference, {"received", "ideal", "files"});
+    if (r.get("references_dir", rc.references_dir)) {
+      std::filesystem::path p(rc.references_dir);
+      if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
+      rc.references_dir = p.string();
+    }
+    if (rc.reference == "files" && rc.references_dir.empty()) r.error("reference", "'files' needs references_dir");
+    r.get_range("full_scale_v", rc.full_scale_v, 1e-6, 1e4);
+    r.get_range("calibration_distance_m", rc.calibration_distance_m, 0.01, 20);
+  });
+  top.finish();
+
+  // The receiver follows the excitation and the sample rate; check the combination now so a
+  // bad scene fails at load time, naming the file.
+  auto& rc = s.receiver.config;
+  rc.carrier_hz = s.excitation.carrier_hz;
+  rc.cycles_per_chip = s.excitation.cycles_per_chip;
+  rc.fs = s.fs;
+  rc.filter.fs = s.fs;
+  rc.family = s.excitation.families.front();
+  if (s.receiver.reference != "files") rc.reference = s.receiver.reference;
+  rc.reference_transducer.centre_hz = s.transducers.centre_hz;
+  rc.reference_transducer.q = s.transducers.q;
+  fit_decimation_to_chip(rc);  // also per family in SceneSimulator (q_of)
+  try {
+    validate(rc);
+    validate(TransducerParams{s.transducers.centre_hz, s.transducers.q, false}, s.fs);
+    ExcitationParams ex{s.excitation.carrier_hz, s.excitation.cycles_per_chip, s.fs, 1.0};
+    validate(ex);
+  } catch (const InputError& e) {
+    throw InputError(origin + ": " + e.what());
+  }
+  return s;
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the scene file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  return parse_scene(ss.str(), path, dir.empty() ? "." : dir);
+}
+
+}  // namespace ranging

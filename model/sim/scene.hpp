@@ -1,0 +1,106 @@
+#pragma once
+// A scene: what the user wants simulated (docs/scenes.md). Every section but geometry is
+// optional, and a stage of the channel exists only when the scene names what it needs
+// (model/sim/scene_simulator.hpp). The loader is strict: unknown keys, wrong types and
+// out-of-range values are InputErrors naming "file:line: field".
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/sim/medium.hpp"
+#include "model/dsp/receiver.hpp"
+
+namespace ranging {
+
+struct SceneMedium {
+  std::optional<AirConditions> air;        // temperature/humidity/pressure: absorption stage
+  std::optional<double> speed_of_sound;    // fixed c (overrides the one computed from air)
+};
+
+struct SceneTransducers {
+  double centre_hz = 200e3;
+  double q = 7.5;                 // or bandwidth_hz = centre_hz / q
+  double beam_angle_deg = 14.5;   // full -3 dB beam angle (piston directivity)
+  bool named = false;             // the scene has a transducers section: resonator stage
+};
+
+// Pitch-catch sensitivity: received volts per transmitted volt on axis at 0.1 m at the
+// centre frequency. Applies with or without the transducers section (the ideal link keeps
+// the level), calibrated in docs/scenes.md against Table 4's M1 energy.
+inline constexpr double kDefaultSensitivity = 0.02;
+
+struct SceneGeometry {
+  std::string type = "static";           // room for "moving" (a later issue)
+  std::vector<double> distances_m;       // line of sight TX-RX, m
+  int repeats = 1;
+  std::optional<double> angle_deg;       // off-axis angle of both transducers: directivity stage
+};
+
+struct SceneSchedule {
+  std::string mode = "single";  // single: one burst per measurement; periodic: a train
+  double period_s = 0;          // periodic: burst period T
+  int bursts = 0;               // periodic: bursts per train (0: eta, every code once)
+};
+
+struct SceneExcitation {
+  std::vector<std::string> families = {"Gold4"};
+  int cycles_per_chip = 4;      // q
+  std::map<std::string, int> cycles_per_chip_by_family;  // q overrides (the paper: M3/M4 at q = 2)
+  int q_of(const std::string& family) const {
+    const auto it = cycles_per_chip_by_family.find(family);
+    return it != cycles_per_chip_by_family.end() ? it->second : cycles_per_chip;
+  }
+  double carrier_hz = 200e3;
+  double drive_vpp = 5.0;       // signal generator, Vpp
+  double amplifier_gain = 10.0; // V/V
+  std::vector<int> codes;       // 1-based j to send; empty: all of the family
+  SceneSchedule schedule;
+  double amplitude() const { return drive_vpp / 2.0 * amplifier_gain; }
+};
+
+struct SceneAdc {
+  int bits = 12;
+  double full_scale_v = 1.0;   // +-full_scale_v maps to the code range; beyond clips
+};
+
+struct SceneNoise {
+  bool named = false;
+  std::optional<double> snr_db;   // vs the mean square of the noise-free burst over its T_d
+  std::optional<double> noise_v;  // or an absolute rms, volts
+  std::uint64_t seed = 1;
+  std::optional<SceneAdc> adc;    // ADC stage
+};
+
+struct SceneReceiver {
+  ReceiverConfig config;            // family/q/carrier/fs follow the excitation and the scene
+  std::string precision = "float";  // float | fixed
+  std::string reference = "received";  // received | ideal | files (Pearson templates)
+  std::string references_dir;       // reference = files
+  double full_scale_v = 1.0;        // receiver input scale without an ADC stage
+  double calibration_distance_m = 0.1;
+};
+
+struct Scene {
+  std::string name = "scene";
+  std::string origin;               // file the scene came from
+  double fs = 5e6;                  // simulation = ADC sample rate (sample_rate, adc.sample_rate)
+  SceneMedium medium;
+  SceneTransducers transducers;
+  double sensitivity = kDefaultSensitivity;
+  SceneGeometry geometry;
+  SceneExcitation excitation;
+  SceneNoise noise;
+  SceneReceiver receiver;
+  double max_range_m = 0;           // L of eq. 3/4 (0: the largest distance)
+
+  double speed() const;             // c used by the channel and by the receiver's ToF -> d
+  double range_l() const;
+};
+
+Scene load_scene(const std::string& path);
+// origin names the file in errors; base_dir resolves relative paths (receiver.config, ...).
+Scene parse_scene(const std::string& yaml_text, const std::string& origin, const std::string& base_dir = ".");
+
+}  // namespace ranging

@@ -1,0 +1,598 @@
+#include "model/sim/scene_simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include "model/sim/capture.hpp"
+#include "model/sim/channel.hpp"
+#include "model/base/error.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/sim/metrics.hpp"
+
+namespace ranging {
+
+double piston_directivity(double beam_angle_deg, double angle_deg) {
+  // 2 J1(x)/x = 1/sqrt(2) at x = 1.616340 (the -3 dB point of a piston).
+  constexpr double x3db = 1.6163399561827614;
+  const double ka = x3db / std::sin(beam_angle_deg / 2.0 * std::numbers::pi / 180.0);
+  const double x = ka * std::sin(angle_deg * std::numbers::pi / 180.0);
+  if (std::abs(x) < 1e-9) return 1.0;
+  return std::abs(2.0 * std::cyl_bessel_j(1.0, x) / x);
+}
+
+namespace {
+
+std::string fmt(double v, int prec = 4) {
+  std::ostringstream os;
+  os.precision(prec);
+  os << v;
+  return os.str();
+}
+
+// Near-field length N = a^2 / lambda of a piston with the scene's beam angle.
+double near_field_m(const Scene& s) {
+  constexpr double x3db = 1.6163399561827614;
+  const double lambda = s.speed() / s.transducers.centre_hz;
+  const double a = x3db / std::sin(s.transducers.beam_angle_deg / 2.0 * std::numbers::pi / 180.0) *
+                   lambda / (2.0 * std::numbers::pi);
+  return a * a / lambda;
+}
+
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+struct Sparse {
+  long start = 0;              // sample index of y[0] (may be negative: clipped when added)
+  std::vector<double> y;
+};
+
+struct Burst {
+  int code = 0;        // 1-based
+  double tx_s = 0;     // transmission time
+};
+
+}  // namespace
+
+std::vector<SceneStage> scene_stages(const Scene& s) {
+  std::vector<SceneStage> st;
+  if (s.transducers.named) {
+    st.push_back({"transducers", "TX and RX resonators, centre " + fmt(s.transducers.centre_hz / 1e3) +
+                                     " kHz, Q " + fmt(s.transducers.q) + ", beam " +
+                                     fmt(s.transducers.beam_angle_deg) + " deg, near field " +
+                                     fmt(near_field_m(s) * 1e3) + " mm"});
+  }
+  if (s.geometry.angle_deg) {
+    st.push_back({"directivity", "piston, beam " + fmt(s.transducers.beam_angle_deg) + " deg at " +
+                                     fmt(*s.geometry.angle_deg) + " deg off axis: gain " +
+                                     fmt(std::pow(piston_directivity(s.transducers.beam_angle_deg,
+                                                                     *s.geometry.angle_deg), 2))});
+  }
+  if (s.medium.air) {
+    const auto& a = *s.medium.air;
+    st.push_back({"absorption", "ISO 9613-1 at " + fmt(a.temperature_c) + " C, " + fmt(a.relative_humidity) +
+                                    " % RH, " + fmt(a.pressure_kpa) + " kPa: " +
+                                    fmt(absorption_db_per_m(s.excitation.carrier_hz, a)) + " dB/m at the carrier"});
+  }
+  st.push_back({"delay", "d/c with c = " + fmt(s.speed(), 6) + " m/s, 64-tap fractional delay"});
+  st.push_back({"gain", "spherical spreading 0.1 m/d, sensitivity " + fmt(s.sensitivity) + " V/V, drive " +
+                            fmt(s.excitation.amplitude()) + " V peak"});
+  if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
+    st.push_back({"noise", (s.noise.snr_db ? "white Gaussian at SNR " + fmt(*s.noise.snr_db) + " dB"
+                                           : "white Gaussian " + fmt(*s.noise.noise_v) + " V rms") +
+                               ", seed " + std::to_string(s.noise.seed)});
+  }
+  if (s.noise.adc) {
+    st.push_back({"adc", std::to_string(s.noise.adc->bits) + " bits over +-" + fmt(s.noise.adc->full_scale_v) +
+                             " V, clipping, " + fmt(s.fs / 1e6) + " MS/s"});
+  }
+  return st;
+}
+
+// ---------------------------------------------------------------------------------------
+
+struct SceneSimulator::Link {
+  const Scene* scene = nullptr;
+  std::string family_name;
+  ReceiverDesign design;
+  int L = 0, spc = 0;
+  std::size_t template_len = 0;
+  std::vector<double> offset;                   // receiver latency per code, samples
+  std::vector<std::vector<double>> templates;   // Pearson references per code
+  std::map<std::pair<int, long long>, Sparse> cache;  // (code, distance in nm) -> clean burst
+  std::map<long long, std::vector<double>> fir_cache;
+  std::uint64_t overflows = 0;
+
+  double c() const { return scene->speed(); }
+  double fs() const { return scene->fs; }
+  bool fixed() const { return scene->receiver.precision == "fixed"; }
+  double input_scale() const {
+    return scene->noise.adc ? scene->noise.adc->full_scale_v : scene->receiver.full_scale_v;
+  }
+
+  // Noise-free received burst of code j sent at t = 0 over distance d (volts).
+  const Sparse& clean(int code, double d) {
+    const auto key = std::make_pair(code, std::llround(d * 1e9));
+    if (auto it = cache.find(key); it != cache.end()) return it->second;
+    const Scene& s = *scene;
+    ExcitationParams ex{s.excitation.carrier_hz, design.config.cycles_per_chip, s.fs, s.excitation.amplitude()};
+    std::vector<double> z = bpsk_excitation(design.family.codes[static_cast<std::size_t>(code - 1)], ex);
+    long z0 = 0;  // sample index of z[0]
+    if (s.transducers.named) {
+      // 30 amplitude time constants Q/(pi f0) of ring-down.
+      const double tau = s.transducers.q / (std::numbers::pi * s.transducers.centre_hz) * s.fs;
+      z.resize(z.size() + static_cast<std::size_t>(std::ceil(30.0 * tau)) + 16, 0.0);
+      const TransducerParams tp{s.transducers.centre_hz, s.transducers.q, false};
+      Transducer tx(tp, s.fs), rx(tp, s.fs);
+      for (double& v : z) v = rx.execute(tx.execute(v));
+    }
+    if (s.medium.air) {
+      auto& h = fir_cache[key.second];
+      if (h.empty()) h = absorption_fir(*s.medium.air, d, s.fs);
+      const long half = static_cast<long>(h.size() / 2);
+      std::vector<double> w(z.size() + h.size() - 1, 0.0);
+      for (std::size_t n = 0; n < z.size(); ++n) {
+        if (z[n] == 0.0) continue;
+        for (std::size_t i = 0; i < h.size(); ++i) w[n + i] += z[n] * h[i];
+      }
+      z = std::move(w);
+      z0 -= half;
+    }
+    double g = s.sensitivity * kReferenceDistance / d;
+    if (s.geometry.angle_deg) g *= std::pow(piston_directivity(s.transducers.beam_angle_deg, *s.geometry.angle_deg), 2);
+    // Fractional delay of the whole burst (propagate()'s interpolator).
+    const double shift = d / c() * s.fs + static_cast<double>(z0);
+    const double whole = std::floor(shift);
+    const auto taps = fractional_delay_taps(shift - whole);
+    constexpr long m_lo = -(kDelayTaps / 2 - 1);
+    const long I = static_cast<long>(whole);
+    Sparse out;
+    out.start = I + m_lo;
+    out.y.assign(z.size() + kDelayTaps - 1, 0.0);
+    for (std::size_t j = 0; j < z.size(); ++j) {
+      if (z[j] == 0.0) continue;
+      for (std::size_t i = 0; i < static_cast<std::size_t>(kDelayTaps); ++i) {
+        // output k = I + m + j with m = m_lo + i  ->  out index j + (kDelayTaps - 1 - i)?
+        // y[k] = sum_i taps[i] z[k - I - (m_lo + i)]: for fixed j, k = I + m_lo + i + j.
+        out.y[j + i] += g * taps[i] * z[j];
+      }
+    }
+    return cache.emplace(key, std::move(out)).first->second;
+  }
+
+  static void add_into(std::vector<double>& x, const Sparse& b, long shift) {
+    for (std::size_t n = 0; n < b.y.size(); ++n) {
+      const long k = b.start + shift + static_cast<long>(n);
+      if (k >= 0 && k < static_cast<long>(x.size())) x[static_cast<std::size_t>(k)] += b.y[n];
+    }
+  }
+
+  // Runs the receiver of the scene's precision over x (volts); returns its events and the
+  // float bandpass output in volts.
+  std::vector<Event> receive(const std::vector<double>& volts, double scale, std::vector<double>& filtered) {
+    std::vector<Event> ev;
+    filtered.resize(volts.size());
+    const double inv = 1.0 / scale;
+    if (!fixed()) {
+      ReceiverFloat rf(design);
+      for (std::size_t n = 0; n < volts.size(); ++n) {
+        if (auto e = rf.execute(volts[n] * inv)) ev.push_back(*e);
+        filtered[n] = rf.filtered() * scale;
+      }
+      if (auto e = rf.flush()) ev.push_back(*e);
+    } else {
+      ReceiverFixed rx(design);
+      BandpassFloat bp(design.filter);
+      for (std::size_t n = 0; n < volts.size(); ++n) {
+        const double x = std::clamp(volts[n] * inv, -1.0, 1.0);
+        if (auto e = rx.execute(x)) ev.push_back(*e);
+        filtered[n] = bp.execute(volts[n]);
+      }
+      if (auto e = rx.flush()) ev.push_back(*e);
+      overflows += rx.overflow_events().total();
+    }
+    return ev;
+  }
+
+  std::size_t stream_tail() const { return static_cast<std::size_t>((3 * L + 6) * spc) + 2000; }
+
+  void calibrate() {
+    const Scene& s = *scene;
+    const double d = s.receiver.calibration_distance_m;
+    const std::size_t eta = design.family.codes.size();
+    offset.assign(eta, 0.0);
+    templates.assign(eta, {});
+    const double delay = d / c() * s.fs;
+    for (std::size_t j = 0; j < eta; ++j) {
+      const Sparse& b = clean(static_cast<int>(j) + 1, d);
+      std::vector<double> x(static_cast<std::size_t>(std::max<long>(b.start, 0)) + b.y.size() + stream_tail(), 0.0);
+      add_into(x, b, 0);
+      double peak = 0;
+      for (double v : x) peak = std::max(peak, std::abs(v));
+      std::vector<double> f;
+      // Calibrate at half full scale so the fixed receiver sees a healthy level.
+      const auto ev = receive(x, peak / 0.5, f);
+      const Event* best = nullptr;
+      for (const auto& e : ev) {
+        if (!best || e.score > best->score) best = &e;
+      }
+      if (!best || best->code != static_cast<int>(j) + 1) {
+        throw InputError(s.origin + ": calibration: code " + std::to_string(j + 1) + " of " + family_name +
+                         " was not decoded on a noise-free burst at " + fmt(d) +
+                         " m; lower receiver.threshold or check the scene's stages");
+      }
+      offset[j] = best->arrival - delay;
+      const std::size_t start = static_cast<std::size_t>(std::lround(delay));
+      if (s.receiver.reference == "received") {
+        templates[j].assign(f.begin() + static_cast<long>(start), f.begin() + static_cast<long>(start + template_len));
+      } else if (s.receiver.reference == "ideal") {
+        ExcitationParams ex{s.excitation.carrier_hz, design.config.cycles_per_chip, s.fs, 1.0};
+        templates[j] = bpsk_excitation(design.family.codes[j], ex);
+        templates[j].resize(template_len, 0.0);
+      }
+    }
+    // Recorded references are aligned by the receiver's calibrated arrival, so every offset first.
+    if (s.receiver.reference == "files") {
+      for (std::size_t j = 0; j < eta; ++j) templates[j] = load_reference(static_cast<int>(j) + 1);
+    }
+  }
+
+  std::vector<double> load_reference(int j) {
+    const Scene& s = *scene;
+    namespace fs = std::filesystem;
+    const std::string stem = s.receiver.references_dir + "/" + family_name + "-" + std::to_string(j);
+    std::string path;
+    for (const char* ext : {".csv", ".wav"}) {
+      if (fs::exists(stem + ext)) path = stem + ext;
+    }
+    if (path.empty()) {
+      throw InputError(s.receiver.references_dir + ": no reference for code " + std::to_string(j) + " (expected " +
+                       stem + ".csv or .wav)");
+    }
+    Capture c = read_capture(path);
+    if (std::abs(c.sample_rate - s.fs) > 1e-4 * s.fs) {
+      throw InputError(path + ": reference sampled at " + fmt(c.sample_rate, 9) + " Hz, the signal at " +
+                       fmt(s.fs, 9) + " Hz");
+    }
+    const std::size_t burst = static_cast<std::size_t>(L * spc);
+    if (c.samples.size() < burst) {
+      throw InputError(path + ": too short: " + std::to_string(c.samples.size()) + " samples, a " + family_name +
+                       " burst is " + std::to_string(burst));
+    }
+    // A recording has its own time origin: the receiver finds the burst in it, and the template
+    // (filtered like the received signal: the paper's references are filtered signals) starts at
+    // its calibrated arrival, as the segments it is compared with do (metrics()).
+    std::vector<double> x = c.samples;
+    double peak = 0;
+    for (double v : x) peak = std::max(peak, std::abs(v));
+    if (peak == 0.0) throw InputError(path + ": reference is all zero");
+    x.resize(x.size() + stream_tail(), 0.0);
+    std::vector<double> y;
+    const Event* best = nullptr;
+    const auto ev = receive(x, peak / 0.5, y);
+    for (const auto& e : ev) {
+      if (!best || e.score > best->score) best = &e;
+    }
+    if (!best) throw InputError(path + ": the receiver detects no " + family_name + " burst in this reference");
+    const long k0 = std::lround(best->arrival - offset[static_cast<std::size_t>(best->code - 1)]);
+    std::vector<double> t(template_len, 0.0);
+    for (std::size_t i = 0; i < template_len; ++i) {
+      const long k = k0 + static_cast<long>(i);
+      if (k >= 0 && k < static_cast<long>(c.samples.size())) t[i] = y[static_cast<std::size_t>(k)];
+    }
+    return t;
+  }
+
+  // Events -> detections: calibrated arrival, ToF against the schedule, the paper's metrics.
+  std::vector<Detection> detections(const std::vector<Event>& ev, const std::vector<double>& filtered, double t0,
+                                    const std::vector<Burst>& schedule) {
+    std::vector<Detection> out;
+    for (const auto& e : ev) {
+      Detection d;
+      d.code = e.code;
+      d.score = e.score;
+      const double a = e.arrival - offset[static_cast<std::size_t>(e.code - 1)];
+      d.arrival_s = t0 + a / fs();
+      double tx = 0;
+      bool found = false;
+      for (const auto& b : schedule) {
+        if (b.code == e.code && b.tx_s <= d.arrival_s && (!found || b.tx_s > tx)) {
+          tx = b.tx_s;
+          found = true;
+        }
+      }
+      d.tof_s = d.arrival_s - tx;
+      metrics(d, filtered, std::lround(a));
+      out.push_back(d);
+    }
+    return out;
+  }
+
+  void metrics(Detection& d, const std::vector<double>& f, long start) const {
+    if (start < 0 || static_cast<std::size_t>(start) + template_len > f.size()) return;
+    std::span<const double> seg(f.data() + start, template_len);
+    std::vector<double> rhos;
+    for (const auto& t : templates) rhos.push_back(pearson(seg, t));
+    const Distinguishability dist = distinguishability(rhos);
+    d.pearson_code = dist.best_code;
+    d.rho_max = dist.rho_max;
+    d.rho_submax = dist.rho_submax;
+    d.u = dist.u;
+    d.energy = energy(seg);
+    const long lo = std::max<long>(0, start - spc);
+    const long hi = std::min<long>(static_cast<long>(f.size()), start + static_cast<long>((L + 4) * spc));
+    try {
+      d.td_s = duration_td(std::span<const double>(f.data() + lo, static_cast<std::size_t>(hi - lo)), fs()).seconds;
+    } catch (const InputError&) {
+      d.td_s = 0;
+    }
+  }
+};
+
+SceneSimulator::SceneSimulator(Scene scene) : scene_(std::move(scene)), stages_(scene_stages(scene_)) {
+  if (scene_.transducers.named) {
+    const double nf = near_field_m(scene_);
+    for (double d : scene_.geometry.distances_m) {
+      if (d < nf) {
+        throw InputError(scene_.origin + ": geometry.distances_m: " + fmt(d) + " m is inside the near field (" +
+                         fmt(nf * 1e3) + " mm) of the transducers; the model is far-field");
+      }
+    }
+  }
+}
+SceneSimulator::~SceneSimulator() = default;
+
+SceneSimulator::Link& SceneSimulator::link(const std::string& family) {
+  for (auto& l : links_) {
+    if (l->family_name == family) return *l;
+  }
+  auto l = std::make_unique<Link>();
+  l->scene = &scene_;
+  l->family_name = family;
+  ReceiverConfig cfg = scene_.receiver.config;
+  cfg.family = family;
+  cfg.cycles_per_chip = scene_.excitation.q_of(family);
+  fit_decimation_to_chip(cfg);
+  try {
+    l->design = design_receiver(cfg);
+  } catch (const InputError& e) {
+    throw InputError(scene_.origin + ": receiver: " + e.what());
+  }
+  l->L = l->design.family.length;
+  l->spc = cfg.chip_samples();
+  l->template_len = static_cast<std::size_t>((l->L + 3) * l->spc);
+  l->calibrate();
+  links_.push_back(std::move(l));
+  return *links_.back();
+}
+
+namespace {
+std::vector<int> codes_sent(const Scene& s, int eta) {
+  std::vector<int> codes = s.excitation.codes;
+  if (codes.empty()) {
+    for (int j = 1; j <= eta; ++j) codes.push_back(j);
+  }
+  return codes;
+}
+}  // namespace
+
+std::size_t SceneSimulator::streams(const std::string& family) const {
+  const int eta = code_family(family).eta();
+  const std::size_t per = scene_.excitation.schedule.mode == "periodic" ? 1 : codes_sent(scene_, eta).size();
+  return per * scene_.geometry.distances_m.size() * static_cast<std::size_t>(scene_.geometry.repeats);
+}
+
+std::vector<Measurement> SceneSimulator::run(const std::string& family, const std::function<void()>& tick,
+                                             const std::function<void(const CaptureStream&)>& capture,
+                                             std::size_t* false_alarms, std::uint64_t* overflows) {
+  Link& lk = link(family);
+  const Scene& s = scene_;
+  const int eta = lk.design.family.eta();
+  const std::vector<int> codes = codes_sent(s, eta);
+  const bool periodic = s.excitation.schedule.mode == "periodic";
+  std::size_t family_index = 0;
+  for (std::size_t i = 0; i < s.excitation.families.size(); ++i) {
+    if (s.excitation.families[i] == family) family_index = i;
+  }
+  // The trains: single mode sends each code alone; periodic sends codes in order every T.
+  std::vector<std::vector<Burst>> trains;
+  if (periodic) {
+    const int n = s.excitation.schedule.bursts > 0 ? s.excitation.schedule.bursts : static_cast<int>(codes.size());
+    std::vector<Burst> t;
+    for (int k = 0; k < n; ++k) t.push_back({codes[static_cast<std::size_t>(k) % codes.size()], k * s.excitation.schedule.period_s});
+    trains.push_back(t);
+  } else {
+    for (int j : codes) trains.push_back({{j, 0.0}});
+  }
+  const double window_samples = lk.L * lk.spc;
+  const double match = periodic ? std::min(window_samples, s.excitation.schedule.period_s * s.fs / 2.0) : window_samples;
+
+  std::vector<Measurement> rows;
+  std::size_t fa = 0;
+  lk.overflows = 0;
+  for (std::size_t di = 0; di < s.geometry.distances_m.size(); ++di) {
+    const double d = s.geometry.distances_m[di];
+    for (int rep = 1; rep <= s.geometry.repeats; ++rep) {
+      for (std::size_t ti = 0; ti < trains.size(); ++ti) {
+        const auto& train = trains[ti];
+        // Assemble the stream.
+        long end = 0;
+        std::vector<long> shifts;
+        for (const auto& b : train) {
+          const Sparse& cb = lk.clean(b.code, d);
+          // Transmission times on the sample grid; the fractional part would need its own
+          // interpolation, so periods are rounded to samples (documented).
+          const long sh = std::lround(b.tx_s * s.fs);
+          shifts.push_back(sh);
+          end = std::max(end, cb.start + sh + static_cast<long>(cb.y.size()));
+        }
+        std::vector<double> x(static_cast<std::size_t>(std::max<long>(end, 0)) + lk.stream_tail(), 0.0);
+        for (std::size_t k = 0; k < train.size(); ++k) Link::add_into(x, lk.clean(train[k].code, d), shifts[k]);
+        if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
+          double sigma = s.noise.noise_v.value_or(0.0);
+          if (s.noise.snr_db) {
+            const Sparse& cb = lk.clean(train.front().code, d);
+            const Duration td = duration_td(cb.y, s.fs);
+            double ms = 0;
+            for (std::size_t n = td.first; n <= td.last; ++n) ms += cb.y[n] * cb.y[n];
+            ms /= static_cast<double>(td.last - td.first + 1);
+            sigma = std::sqrt(ms / std::pow(10.0, *s.noise.snr_db / 10.0));
+          }
+          std::uint64_t seed = splitmix(s.noise.seed);
+          seed = splitmix(seed ^ (family_index + 1));
+          seed = splitmix(seed ^ (di + 1) * 0x100000001B3ull);
+          seed = splitmix(seed ^ (static_cast<std::uint64_t>(rep) << 20) ^ ti);
+          std::mt19937_64 rng(seed);
+          std::normal_distribution<double> nd(0.0, sigma);
+          for (double& v : x) v += nd(rng);
+        }
+        if (s.noise.adc) {
+          const double q = s.noise.adc->full_scale_v / std::ldexp(1.0, s.noise.adc->bits - 1);
+          const double top = std::ldexp(1.0, s.noise.adc->bits - 1);
+          for (double& v : x) v = std::clamp(std::round(v / q), -top, top - 1) * q;
+        }
+        if (capture) capture({family, d, rep, periodic ? 0 : train.front().code, s.fs, &x});
+        std::vector<double> f;
+        const auto ev = lk.receive(x, lk.input_scale(), f);
+        const auto dets = lk.detections(ev, f, 0.0, train);
+        std::vector<bool> used(dets.size(), false);
+        for (std::size_t k = 0; k < train.size(); ++k) {
+          Measurement m;
+          m.family = family;
+          m.repeat = rep;
+          m.burst = static_cast<int>(k);
+          m.true_distance_m = d;
+          m.code_sent = train[k].code;
+          const double truth = (train[k].tx_s + d / lk.c()) * s.fs;
+          int best = -1;
+          for (std::size_t i = 0; i < dets.size(); ++i) {
+            if (std::abs(dets[i].arrival_s * s.fs - truth) > match) continue;
+            if (best < 0 || dets[i].score > dets[static_cast<std::size_t>(best)].score) best = static_cast<int>(i);
+          }
+          if (best >= 0) {
+            used[static_cast<std::size_t>(best)] = true;
+            m.detected = true;
+            m.det = dets[static_cast<std::size_t>(best)];
+            m.distance_m = m.det.tof_s * lk.c();
+            m.error_m = m.distance_m - d;
+          } else {
+            lk.metrics(m.det, f, std::lround(truth));  // the paper's metrics at the true alignment
+          }
+          rows.push_back(m);
+        }
+        for (bool u : used) fa += !u;
+        if (tick) tick();
+      }
+    }
+  }
+  if (false_alarms) *false_alarms = fa;
+  if (overflows) *overflows = lk.overflows;
+  return rows;
+}
+
+std::vector<Detection> SceneSimulator::decode(const std::string& family, const std::vector<double>& x, double t0,
+                                              double period_s) {
+  Link& lk = link(family);
+  double peak = 0;
+  for (double v : x) peak = std::max(peak, std::abs(v));
+  if (peak == 0) return {};
+  std::vector<Burst> schedule;
+  const int eta = lk.design.family.eta();
+  const double span = t0 + static_cast<double>(x.size()) / scene_.fs;
+  if (period_s > 0) {
+    for (long k = 0; k * period_s <= span; ++k) schedule.push_back({static_cast<int>(k % eta) + 1, k * period_s});
+  } else {
+    for (int j = 1; j <= eta; ++j) schedule.push_back({j, 0.0});
+  }
+  std::vector<double> f;
+  // The receiver sees the capture at half full scale at its peak; f comes back in capture units.
+  const auto ev = lk.receive(x, peak / 0.5, f);
+  const long s0 = std::lround(t0 * scene_.fs);  // sample index of x[0] on the t = 0 grid
+  auto dets = lk.detections(ev, f, static_cast<double>(s0) / scene_.fs, schedule);
+  return dets;
+}
+
+std::vector<double> SceneSimulator::filtered_burst(const std::string& family, int code, double d) {
+  Link& lk = link(family);
+  const Sparse& b = lk.clean(code, d);
+  std::vector<double> x(static_cast<std::size_t>(std::max<long>(b.start, 0)) + b.y.size() + 200, 0.0);
+  Link::add_into(x, b, 0);
+  BandpassFloat bp(lk.design.filter);
+  for (double& v : x) v = bp.execute(v);
+  return x;
+}
+
+FamilySummary summarize(const Scene& scene, const std::string& family, const std::vector<Measurement>& rows,
+                        std::size_t false_alarms) {
+  FamilySummary s;
+  s.family = family;
+  s.eta = code_family(family).eta();
+  s.false_alarms = false_alarms;
+  const auto eta = static_cast<std::size_t>(s.eta);
+  double dmax = 0;
+  for (const auto& r : rows) dmax = std::max(dmax, r.true_distance_m);
+  std::vector<double> usum(eta, 0), un(eta, 0), esum(eta, 0), en(eta, 0);
+  std::map<std::pair<int, long long>, std::pair<double, int>> td;  // (code, d) -> sum, n
+  double se = 0;
+  std::size_t nse = 0;
+  for (const auto& r : rows) {
+    if (r.family != family) continue;
+    ++s.measurements;
+    const auto j = static_cast<std::size_t>(r.code_sent - 1);
+    if (!r.detected) ++s.missed;
+    if (!r.detected || r.det.code != r.code_sent) {
+      ++s.decode_errors;
+    } else {
+      se += r.error_m * r.error_m;
+      ++nse;
+    }
+    usum[j] += r.det.u;
+    un[j] += 1;
+    if (r.true_distance_m == dmax) {
+      esum[j] += r.det.energy;
+      en[j] += 1;
+    }
+    auto& t = td[{r.code_sent, std::llround(r.true_distance_m * 1e9)}];
+    t.first += r.det.td_s;
+    t.second += 1;
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  s.u_per_code.assign(eta, nan);
+  s.energy_per_code.assign(eta, nan);
+  s.td_per_code.assign(eta, nan);
+  s.u_min = s.energy_min = std::numeric_limits<double>::infinity();
+  s.td_max_s = 0;
+  for (std::size_t j = 0; j < eta; ++j) {
+    if (un[j] > 0) {
+      s.u_per_code[j] = usum[j] / un[j];
+      s.u_min = std::min(s.u_min, s.u_per_code[j]);
+    }
+    if (en[j] > 0) {
+      s.energy_per_code[j] = esum[j] / en[j];
+      s.energy_min = std::min(s.energy_min, s.energy_per_code[j]);
+    }
+  }
+  for (const auto& [key, v] : td) {
+    const auto j = static_cast<std::size_t>(key.first - 1);
+    const double mean = v.first / v.second;
+    if (std::isnan(s.td_per_code[j]) || mean > s.td_per_code[j]) s.td_per_code[j] = mean;
+    s.td_max_s = std::max(s.td_max_s, mean);
+  }
+  if (s.measurements == 0) s.u_min = s.energy_min = nan;
+  s.error_rate = s.measurements ? static_cast<double>(s.decode_errors) / static_cast<double>(s.measurements) : 0;
+  s.rmse_m = nse ? std::sqrt(se / static_cast<double>(nse)) : nan;
+  const double L = scene.range_l();
+  s.vmax_hz = s.td_max_s > 0 ? vmax(s.td_max_s, s.eta, scene.speed(), L) : nan;
+  return s;
+}
+
+}  // namespace ranging

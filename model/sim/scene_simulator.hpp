@@ -1,0 +1,124 @@
+#pragma once
+// The scene simulator: builds exactly the channel stages a scene names (model/sim/scene.hpp) and
+// runs its measurements through the receiver of the scene's precision.
+//
+// Stages, in signal order (each exists only when the scene asks for it):
+//   transducers  TX and RX resonators (transducers section)
+//   directivity  piston directivity of both transducers at geometry.angle_deg
+//   absorption   ISO 9613-1 air absorption over the path, zero-phase FIR (medium air conditions)
+//   delay        propagation d/c, Kaiser-sinc fractional delay (always)
+//   gain         sensitivity * amplitude * 0.1 m / d, spherical spreading (always)
+//   noise        white Gaussian, snr_db or noise_v, seeded (noise.snr_db / noise.noise_v)
+//   adc          quantization to bits over +-full_scale_v with clipping (noise.adc)
+// The receiver (bandpass -> correlator bank -> peak detector, model/dsp/receiver.hpp) is the sink.
+//
+// Time of flight: the receiver's latency is calibrated once per code on a noise-free burst
+// through the scene's deterministic stages at receiver.calibration_distance_m (the paper's
+// system measures a known distance the same way). The paper's metrics (Pearson rho with
+// received templates, u, energy, T_d) are computed on the float bandpass output at the
+// detected alignment, whatever the receiver precision.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "model/sim/scene.hpp"
+
+namespace ranging {
+
+struct SceneStage {
+  std::string name;         // transducers, directivity, absorption, delay, gain, noise, adc
+  std::string description;  // the parameters it uses
+};
+
+// The channel stages the scene builds (without running anything).
+std::vector<SceneStage> scene_stages(const Scene& scene);
+
+// One received burst as the receiver saw it.
+struct Detection {
+  int code = 0;            // 1-based j (receiver bank)
+  double arrival_s = 0;    // calibrated arrival time from t = 0 (start of the first burst)
+  double tof_s = 0;        // arrival - transmission time of the burst that carried code j
+  double score = 0;        // receiver rho^2
+  int pearson_code = 0;    // the paper's Pearson decoder (eq. 9) at this alignment
+  double rho_max = 0, rho_submax = 0, u = 0;
+  double energy = 0;       // V^2, sum of squares of the filtered signal over the burst window
+  double td_s = 0;         // T_d of the filtered signal around the burst (section 2.2)
+};
+
+struct Measurement {
+  std::string family;
+  int repeat = 0;              // 1-based
+  int burst = 0;               // 0-based index in the train (0 in single mode)
+  double true_distance_m = 0;
+  int code_sent = 0;           // 1-based j
+  bool detected = false;
+  Detection det;               // valid when detected
+  double distance_m = 0;       // tof * c
+  double error_m = 0;          // distance_m - true_distance_m
+};
+
+struct FamilySummary {
+  std::string family;
+  int eta = 0;
+  std::size_t measurements = 0, decode_errors = 0, missed = 0, false_alarms = 0;
+  double error_rate = 0, rmse_m = 0;
+  std::vector<double> u_per_code;        // mean u over all distances and repeats (Fig. 14)
+  std::vector<double> energy_per_code;   // mean energy at the largest distance (Fig. 15)
+  std::vector<double> td_per_code;       // max over distances of the mean T_d per distance
+  double u_min = 0, energy_min = 0, td_max_s = 0, vmax_hz = 0;
+  std::uint64_t overflows = 0;           // fixed precision: saturations and wraps
+};
+
+// What a run writes as a capture: the whole received stream (volts) of one measurement.
+struct CaptureStream {
+  std::string family;
+  double distance_m = 0;
+  int repeat = 0;
+  int code = 0;                // single mode: the code sent; periodic: 0
+  double fs = 0;
+  const std::vector<double>* volts = nullptr;
+};
+
+class SceneSimulator {
+ public:
+  explicit SceneSimulator(Scene scene);
+  ~SceneSimulator();
+  const Scene& scene() const { return scene_; }
+  const std::vector<SceneStage>& stages() const { return stages_; }
+
+  // Every measurement of one family (geometry x repeats x bursts). Deterministic for a seed.
+  std::vector<Measurement> run(const std::string& family,
+                               const std::function<void()>& tick = {},
+                               const std::function<void(const CaptureStream&)>& capture = {},
+                               std::size_t* false_alarms = nullptr, std::uint64_t* overflows = nullptr);
+  // Number of receiver runs (streams) of run(family), for progress bars.
+  std::size_t streams(const std::string& family) const;
+
+  // Decode a recorded stream (volts or any scale; fs must be the scene's): every event the
+  // receiver emits, with t0 the time of sample 0. period_s > 0: the bursts were sent every
+  // period_s, codes 1..eta in order, so tof = arrival - (latest send of that code).
+  std::vector<Detection> decode(const std::string& family, const std::vector<double>& x, double t0,
+                                double period_s = 0);
+
+  // The float-filtered noise-free received burst of a code at a distance (Figure 13), from
+  // the start of transmission, volts.
+  std::vector<double> filtered_burst(const std::string& family, int code, double distance_m);
+
+  struct Link;  // per-family design, calibration and templates (scene_simulator.cpp)
+
+ private:
+  Link& link(const std::string& family);
+  Scene scene_;
+  std::vector<SceneStage> stages_;
+  std::vector<std::unique_ptr<Link>> links_;
+};
+
+FamilySummary summarize(const Scene& scene, const std::string& family,
+                        const std::vector<Measurement>& rows, std::size_t false_alarms = 0);
+
+// Piston directivity |2 J1(x)/x|, x = ka sin(theta), with ka set by the full -3 dB beam angle.
+double piston_directivity(double beam_angle_deg, double angle_deg);
+
+}  // namespace ranging
