@@ -521,6 +521,21 @@ std::vector<Detection> SceneSimulator::decode(const std::string& family, const s
   return dets;
 }
 
+std::vector<Detection> SceneSimulator::receive_stream(const std::string& family, const std::vector<double>& x,
+                                                      double t0, double period_s, std::uint64_t* overflows) {
+  Link& lk = link(family);
+  const int eta = lk.design.family.eta();
+  const double span = t0 + static_cast<double>(x.size()) / scene_.fs;
+  std::vector<Burst> schedule;
+  for (long k = 0; k * period_s <= span; ++k) schedule.push_back({static_cast<int>(k % eta) + 1, k * period_s});
+  std::vector<double> f;
+  lk.overflows = 0;
+  const auto ev = lk.receive(x, lk.input_scale(), f);
+  if (overflows) *overflows += lk.overflows;
+  const long s0 = std::lround(t0 * scene_.fs);
+  return lk.detections(ev, f, static_cast<double>(s0) / scene_.fs, schedule);
+}
+
 std::vector<double> SceneSimulator::filtered_burst(const std::string& family, int code, double d) {
   Link& lk = link(family);
   const Sparse& b = lk.clean(code, d);
