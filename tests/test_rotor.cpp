@@ -291,3 +291,20 @@ TEST(RotorScene, SlowCrossingEndToEnd) {
   std::filesystem::remove_all(dir);
   std::filesystem::remove(path);
 }
+
+TEST(RotorDoppler, ConstantLineOfSightSpeed) {
+  Scene s = parse_scene(
+      "medium: {speed_of_sound: 340}\ntransducers: {sensitivity: 0.165}\ngeometry: {distances_m: [0.5]}\n"
+      "excitation: {family: M1, schedule: {mode: periodic, period_s: 0.00042}}\nreceiver: {precision: fixed}\n",
+      "s.yaml");
+  SceneSimulator sim(s);
+  const DopplerPoint still = doppler_point(sim, 0.5, 0.0, 1);
+  EXPECT_EQ(still.bursts, 7);
+  EXPECT_EQ(still.decoded, 7);
+  EXPECT_LT(std::abs(still.bias_start_m), 1e-4);
+  EXPECT_NEAR(still.doppler, 1.0, 1e-12);
+  // A receiver closing on a fixed source at v hears (c + v)/c.
+  const DopplerPoint moving = doppler_point(sim, 0.5, 17.0, 1);
+  EXPECT_NEAR(moving.doppler, (340.0 + 17.0) / 340.0, 1e-9);
+  EXPECT_EQ(moving.bursts, moving.decoded + moving.misdecoded + moving.missed);
+}

@@ -144,6 +144,19 @@ struct RotorRun {
   std::uint64_t overflows = 0;
 };
 
+// Doppler at a constant line-of-sight speed: the TX fixed at height d, the RX moving along the
+// common axis at v_los (> 0 closing), reaching z = 0 when the burst's centre arrives; both on
+// axis (no directivity loss), the scene's transducers, absorption, noise, ADC and receiver.
+// Burst k = 0..eta*repeats-1 is emitted alone at k T (code (k mod eta) + 1), one stream each.
+struct DopplerPoint {
+  double los_speed_mps = 0, doppler = 1;   // received / emitted frequency
+  int bursts = 0, decoded = 0, misdecoded = 0, missed = 0;
+  double bias_start_m = std::numeric_limits<double>::quiet_NaN();   // mean c (ToF - true start) over decoded
+  double bias_centre_m = std::numeric_limits<double>::quiet_NaN();  // ... against the centre's flight time
+  double std_m = std::numeric_limits<double>::quiet_NaN();          // spread of c ToF
+};
+DopplerPoint doppler_point(SceneSimulator& sim, double d, double v_los, int repeats);
+
 RotorRun run_rotor(SceneSimulator& sim, const std::function<void()>& tick = {});
 std::size_t rotor_crossings(const Scene& s);
 
