@@ -3,7 +3,7 @@
 
 Runs `ranging simulate` on variants of scenes/blade-crossing.yaml (14.5 degree beam) and
 scenes/blade-crossing-wide.yaml (the paper's 320 mm window), and `ranging doppler`, then
-writes the plots to docs/images/blade-crossing-*.png and prints the tables (markdown).
+writes the plots to docs/results/blade-crossing-*.png and prints the tables (markdown).
 
 usage: scripts/blade_crossing_study.py --tool build/tool/ranging --work DIR [--crossings N]
 """
@@ -74,7 +74,7 @@ def main():
     ap.add_argument("--tool", required=True)
     ap.add_argument("--work", required=True)
     ap.add_argument("--crossings", type=int, default=100)
-    ap.add_argument("--images", default=os.path.join(ROOT, "docs", "images"))
+    ap.add_argument("--images", default=os.path.join(ROOT, "docs", "results"))
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     t0 = time.time()
