@@ -154,6 +154,13 @@ TEST(RotorGeometry, PaperNumbers) {
   EXPECT_NEAR(p.crossing_interval_s(), 60.0 / 450 / 8, 1e-12);
 }
 
+TEST(RotorGeometry, StagesReplaceDelayAndGainByTheMovingChannel) {
+  const auto st = scene_stages(parse_scene(kRotorScene, "s.yaml"));
+  std::string names;
+  for (const auto& x : st) names += x.name + " ";
+  EXPECT_EQ(names, "transducers moving ");
+}
+
 TEST(RotorGeometry, BadGeometryNamesTheKey) {
   auto has = [](const std::string& yaml, const std::string& what) {
     const std::string e = error_of(yaml);

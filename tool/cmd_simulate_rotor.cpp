@@ -48,13 +48,11 @@ int simulate_rotor(SceneSimulator& sim, const std::string& out, bool json, bool 
   const Scene& s = sim.scene();
   const RotorParams& p = s.geometry.rotor;
   if (!json) {
-    std::printf("  %-12s %s\n", "rotor",
+    std::printf("  %s: %s\n", "rotor",
                 ("R " + n9(p.radius_m) + " m, " + n9(p.rpm) + " RPM, " + std::to_string(p.blades) +
                  " blades, transducers at " + n9(p.r()) + " m (" + n9(p.omega_u() * p.r()) + " m/s), " +
                  std::to_string(p.crossings) + " crossings every " + n9(p.crossing_interval_s() * 1e3) + " ms")
                     .c_str());
-    std::printf("  %-12s %s\n", "moving",
-                "emission time solved per sample, Doppler, 1/d, piston directivity at both ends (replaces delay/gain)");
     std::fflush(stdout);
   }
   std::size_t done = 0;
@@ -123,11 +121,20 @@ int simulate_rotor(SceneSimulator& sim, const std::string& out, bool json, bool 
     std::cout << j.dump(2) << "\n";
     return 0;
   }
-  auto rms = [](const Stats& st) { return st.n ? std::sqrt(st.se / static_cast<double>(st.n)) * 1e3 : NAN; };
-  std::printf("\n%zu crossings, %zu bursts rendered, %zu decoded, %zu misdecoded, %zu false alarms\n",
-              run.crossings.size(), run.bursts.size(), decoded, run.misdecodes, run.false_alarms);
-  std::printf("h error rms: motion-aware %.4f mm (%zu estimated, %zu failed), paper eq. 1 %.4f mm (%zu, %zu failed)\n",
-              rms(motion), motion.n, fail_motion, rms(paper), paper.n, fail_paper);
+  auto rms = [](const Stats& st) {
+    if (!st.n) return std::string("none (no crossing with two accepted measurements)");
+    char b[64];
+    std::snprintf(b, sizeof b, "%.4f mm", std::sqrt(st.se / static_cast<double>(st.n)) * 1e3);
+    return std::string(b);
+  };
+  std::printf("\n%zu crossings, %zu bursts rendered, %zu decoded, %zu misdecoded, %zu false alarms, %llu fixed-point"
+              " saturations/wraps\n",
+              run.crossings.size(), run.bursts.size(), decoded, run.misdecodes, run.false_alarms,
+              static_cast<unsigned long long>(run.overflows));
+  std::printf("h error rms, motion-aware: %s; %zu crossings estimated, %zu not\n", rms(motion).c_str(), motion.n,
+              fail_motion);
+  std::printf("h error rms, paper eq. 1:  %s; %zu crossings estimated, %zu not\n", rms(paper).c_str(), paper.n,
+              fail_paper);
   std::printf("\nwrote %s/summary.json, %s/bursts.csv, %s/measurements.csv\n", out.c_str(), out.c_str(), out.c_str());
   return 0;
 }

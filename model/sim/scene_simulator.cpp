@@ -83,9 +83,16 @@ std::vector<SceneStage> scene_stages(const Scene& s) {
                                     " % RH, " + fmt(a.pressure_kpa) + " kPa: " +
                                     fmt(absorption_db_per_m(s.excitation.carrier_hz, a)) + " dB/m at the carrier"});
   }
-  st.push_back({"delay", "d/c with c = " + fmt(s.speed(), 6) + " m/s, 64-tap fractional delay"});
-  st.push_back({"gain", "spherical spreading 0.1 m/d, sensitivity " + fmt(s.sensitivity) + " V/V, drive " +
-                            fmt(s.excitation.amplitude()) + " V peak"});
+  if (s.geometry.type == "rotor") {  // model/sim/moving_channel.hpp replaces delay and gain
+    st.push_back({"moving", "emission time per sample (c = " + fmt(s.speed(), 6) +
+                                " m/s), Doppler, spreading 0.1 m/d, piston directivity of both moving transducers, "
+                                "sensitivity " + fmt(s.sensitivity) + " V/V, drive " + fmt(s.excitation.amplitude()) +
+                                " V peak"});
+  } else {
+    st.push_back({"delay", "d/c with c = " + fmt(s.speed(), 6) + " m/s, 64-tap fractional delay"});
+    st.push_back({"gain", "spherical spreading 0.1 m/d, sensitivity " + fmt(s.sensitivity) + " V/V, drive " +
+                              fmt(s.excitation.amplitude()) + " V peak"});
+  }
   if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
     st.push_back({"noise", (s.noise.snr_db ? "white Gaussian at SNR " + fmt(*s.noise.snr_db) + " dB"
                                            : "white Gaussian " + fmt(*s.noise.noise_v) + " V rms") +
