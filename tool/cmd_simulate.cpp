@@ -18,6 +18,7 @@
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/rotor_run.hpp"
 #include "tool/scene_run.hpp"
 
 namespace ranging::tool {
@@ -166,6 +167,9 @@ int cmd_simulate(const Args& args) {
   }
   const std::string out = p.get_or("--out", "out/" + scene.name);
   const bool json = p.has("--json");
+  if (scene.geometry.type == "rotor" && p.has("--write-captures")) {
+    throw InputError("option --write-captures: not available for rotor scenes");
+  }
   SceneSimulator sim(scene);
   if (!json) std::cout << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim) << std::flush;
 
@@ -173,6 +177,7 @@ int cmd_simulate(const Args& args) {
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) throw InputError("option --out: cannot create '" + out + "': " + ec.message());
+  if (scene.geometry.type == "rotor") return simulate_rotor(sim, out, json, p.has("--quiet"));  // tool/rotor_run.hpp
   // Captures go to a staging directory that becomes DIR/captures only when the run succeeds.
   const std::string staging = out + "/.captures.tmp";
   if (p.has("--write-captures")) {

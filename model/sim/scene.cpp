@@ -77,8 +77,12 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
 
   if (!section(top, "geometry", [&](Reader& r) {
         r.get("type", s.geometry.type);
-        if (s.geometry.type == "moving") r.error("type", "'moving' geometry is not implemented yet (a later issue); valid: static");
-        one_of(r, "type", s.geometry.type, {"static"});
+        if (s.geometry.type == "moving") r.error("type", "'moving' geometry is not implemented yet (a later issue); valid: static, rotor");
+        one_of(r, "type", s.geometry.type, {"static", "rotor"});
+        if (s.geometry.type == "rotor") {
+          parse_rotor(r, s.geometry.rotor, s.speed());  // model/sim/rotor.cpp
+          return;
+        }
         if (!r.get_list("distances_m", s.geometry.distances_m) || s.geometry.distances_m.empty()) {
           r.error("distances_m", "give at least one distance (metres)");
         }
@@ -196,6 +200,7 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
     r.get_range("calibration_distance_m", rc.calibration_distance_m, 0.01, 20);
   });
   top.finish();
+  if (s.geometry.type == "rotor") check_rotor_scene(s);  // model/sim/rotor.cpp
 
   // The receiver follows the excitation and the sample rate; check the combination now so a
   // bad scene fails at load time, naming the file.

@@ -11,6 +11,7 @@
 
 #include "model/sim/medium.hpp"
 #include "model/dsp/receiver.hpp"
+#include "model/sim/rotor.hpp"
 
 namespace ranging {
 
@@ -32,10 +33,11 @@ struct SceneTransducers {
 inline constexpr double kDefaultSensitivity = 0.02;
 
 struct SceneGeometry {
-  std::string type = "static";           // room for "moving" (a later issue)
+  std::string type = "static";           // static | rotor (model/sim/rotor.hpp)
   std::vector<double> distances_m;       // line of sight TX-RX, m
   int repeats = 1;
   std::optional<double> angle_deg;       // off-axis angle of both transducers: directivity stage
+  RotorParams rotor;                     // type rotor: the coaxial rotor and its crossings
 };
 
 struct SceneSchedule {

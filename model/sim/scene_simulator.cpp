@@ -83,9 +83,16 @@ std::vector<SceneStage> scene_stages(const Scene& s) {
                                     " % RH, " + fmt(a.pressure_kpa) + " kPa: " +
                                     fmt(absorption_db_per_m(s.excitation.carrier_hz, a)) + " dB/m at the carrier"});
   }
-  st.push_back({"delay", "d/c with c = " + fmt(s.speed(), 6) + " m/s, 64-tap fractional delay"});
-  st.push_back({"gain", "spherical spreading 0.1 m/d, sensitivity " + fmt(s.sensitivity) + " V/V, drive " +
-                            fmt(s.excitation.amplitude()) + " V peak"});
+  if (s.geometry.type == "rotor") {  // model/sim/moving_channel.hpp replaces delay and gain
+    st.push_back({"moving", "emission time per sample (c = " + fmt(s.speed(), 6) +
+                                " m/s), Doppler, spreading 0.1 m/d, piston directivity of both moving transducers, "
+                                "sensitivity " + fmt(s.sensitivity) + " V/V, drive " + fmt(s.excitation.amplitude()) +
+                                " V peak"});
+  } else {
+    st.push_back({"delay", "d/c with c = " + fmt(s.speed(), 6) + " m/s, 64-tap fractional delay"});
+    st.push_back({"gain", "spherical spreading 0.1 m/d, sensitivity " + fmt(s.sensitivity) + " V/V, drive " +
+                              fmt(s.excitation.amplitude()) + " V peak"});
+  }
   if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
     st.push_back({"noise", (s.noise.snr_db ? "white Gaussian at SNR " + fmt(*s.noise.snr_db) + " dB"
                                            : "white Gaussian " + fmt(*s.noise.noise_v) + " V rms") +
@@ -519,6 +526,21 @@ std::vector<Detection> SceneSimulator::decode(const std::string& family, const s
   const long s0 = std::lround(t0 * scene_.fs);  // sample index of x[0] on the t = 0 grid
   auto dets = lk.detections(ev, f, static_cast<double>(s0) / scene_.fs, schedule);
   return dets;
+}
+
+std::vector<Detection> SceneSimulator::receive_stream(const std::string& family, const std::vector<double>& x,
+                                                      double t0, double period_s, std::uint64_t* overflows) {
+  Link& lk = link(family);
+  const int eta = lk.design.family.eta();
+  const double span = t0 + static_cast<double>(x.size()) / scene_.fs;
+  std::vector<Burst> schedule;
+  for (long k = 0; k * period_s <= span; ++k) schedule.push_back({static_cast<int>(k % eta) + 1, k * period_s});
+  std::vector<double> f;
+  lk.overflows = 0;
+  const auto ev = lk.receive(x, lk.input_scale(), f);
+  if (overflows) *overflows += lk.overflows;
+  const long s0 = std::lround(t0 * scene_.fs);
+  return lk.detections(ev, f, static_cast<double>(s0) / scene_.fs, schedule);
 }
 
 std::vector<double> SceneSimulator::filtered_burst(const std::string& family, int code, double d) {

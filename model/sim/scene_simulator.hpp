@@ -102,6 +102,14 @@ class SceneSimulator {
   std::vector<Detection> decode(const std::string& family, const std::vector<double>& x, double t0,
                                 double period_s = 0);
 
+  // The receiver of the scene's precision over a stream of volts at the scene's input scale
+  // (noise.adc.full_scale_v, else receiver.full_scale_v; decode() instead normalizes to the
+  // peak), t0 the time of sample 0 on the t = 0 grid; bursts went out every period_s from
+  // t = 0 with codes 1..eta in turn (the scheduler's rule). Adds the fixed receiver's
+  // saturations/wraps to *overflows.
+  std::vector<Detection> receive_stream(const std::string& family, const std::vector<double>& volts, double t0,
+                                        double period_s, std::uint64_t* overflows = nullptr);
+
   // The float-filtered noise-free received burst of a code at a distance (Figure 13), from
   // the start of transmission, volts.
   std::vector<double> filtered_burst(const std::string& family, int code, double distance_m);
