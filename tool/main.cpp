@@ -30,6 +30,7 @@ constexpr Subcommand kSubcommands[] = {
     {"evaluate", "reproduce the paper's Section 4 evaluation (Tables 4-6, Figures 13-15)",
      ranging::tool::cmd_evaluate},
     {"decode", "decode a recorded capture (oscilloscope CSV or WAV)", ranging::tool::cmd_decode},
+    {"sweep", "design-space sweep: accuracy and cost over axes, Pareto fronts (docs/design-space.md)", ranging::tool::cmd_sweep},
 };
 
 void print_usage(std::ostream& os) {
