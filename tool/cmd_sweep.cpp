@@ -39,9 +39,12 @@ std::string slurp(const fs::path& p) {
 }
 
 std::string source_dir() {
-  // The project tree this binary was built from (rtl/, scripts/), else the working directory.
-  const fs::path here = fs::path(__FILE__).parent_path().parent_path();
-  return fs::exists(here / "rtl/bandpass_sos.v") ? here.string() : fs::current_path().string();
+  // The project tree (rtl/, scripts/): $RANGING_TREE, else the tree this binary was built from,
+  // else the working directory.
+  if (const char* env = std::getenv("RANGING_TREE"); env && *env) return fs::absolute(env).string();
+  const fs::path built = RANGING_TREE;
+  if (fs::exists(built / "rtl/bandpass_sos.v")) return built.string();
+  return fs::current_path().string();
 }
 
 void plot(const std::string& dir) {

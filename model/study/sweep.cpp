@@ -64,7 +64,9 @@ std::string fmt_number(double v) {
 // the point's keys (configuration keys under receiver.config., scene keys without "scene.").
 Overrides point_overrides(const SweepSpec& spec, const Params& params) {
   Overrides ov{{"receiver.config", spec.config_path}, {"receiver.precision", "fixed"}};
-  for (const auto& [k, v] : params) {
+  Params sorted = params;  // the keys are distinct: their order changes nothing but messages
+  std::sort(sorted.begin(), sorted.end());
+  for (const auto& [k, v] : sorted) {
     if (k.rfind("scene.", 0) == 0) {
       ov.push_back({k.substr(6), v});
     } else {
@@ -190,8 +192,10 @@ SweepSpec load_sweep_spec(const std::string& path) {
 }
 
 std::string point_id(const Params& params) {
+  Params sorted = params;  // the same point in any axis order has the same id
+  std::sort(sorted.begin(), sorted.end());
   std::string canon;
-  for (const auto& [k, v] : params) canon += k + "=" + v + "\n";
+  for (const auto& [k, v] : sorted) canon += k + "=" + v + "\n";
   return hex16(splitmix(fnv1a(canon)));
 }
 
