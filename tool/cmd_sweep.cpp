@@ -154,6 +154,8 @@ int cmd_sweep(const Args& args) {
   p.option("--out", "DIR", "output folder (created)");
   p.option("--jobs", "N", "points evaluated in parallel, 1..256 (the output does not depend on it)", "1");
   p.option("--shard", "I/N", "evaluate only the points of shard I of N (a stable hash of their parameters)");
+  p.option("--cache", "DIR", "synthesis cache folder, may be shared by shards (default: DIR/cache)");
+  p.flag("--dry-run", "check the spec, print the ids and parameters of the points (of the shard) and exit; writes nothing");
   p.flag("--no-synth", "skip yosys synth_ice40 (cost: the throughput rule and the word-length proxy only)");
   p.flag("--no-plot", "skip DIR/front.png (no Python needed)");
   p.flag("--quiet", "no progress on stderr");
@@ -184,6 +186,14 @@ int cmd_sweep(const Args& args) {
   for (const auto& pt : study::sweep_points(spec)) {
     if (study::in_shard(pt, shard_i, shard_n)) todo.push_back(pt);
   }
+  if (p.has("--dry-run")) {
+    for (const auto& pt : todo) {
+      std::cout << pt.id;
+      for (const auto& [k, v] : pt.params) std::cout << " " << k << "=" << v;
+      std::cout << (pt.params.empty() ? " (default)\n" : "\n");
+    }
+    return 0;
+  }
   const json spec_j = spec.json();
   std::error_code ec;
   if (fs::exists(out + "/spec.json")) {
@@ -196,12 +206,14 @@ int cmd_sweep(const Args& args) {
   }
   fs::create_directories(out + "/points", ec);
   if (ec) throw InputError("option --out: cannot create '" + out + "': " + ec.message());
-  fs::create_directories(out + "/cache", ec);
+  const std::string cache = p.get_or("--cache", out + "/cache");
+  fs::create_directories(cache, ec);
+  if (ec) throw InputError("option --cache: cannot create '" + cache + "': " + ec.message());
   write_file_atomic(out + "/spec.json", spec_j.dump(2) + "\n");
 
   study::PointOptions opt;
   opt.synth = !p.has("--no-synth");
-  opt.cache_dir = fs::absolute(out + "/cache").string();
+  opt.cache_dir = fs::absolute(cache).string();
   opt.source_dir = source_dir();
   std::map<std::string, json> results;
   std::vector<const PointDef*> pending;
