@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the project needs, only those that are missing.
-# Usage: scripts/install-deps.sh [--hardware]   (--hardware adds the FPGA/HDL tools)
+# Usage: scripts/install-deps.sh [--hardware | --cluster]   (--hardware adds the FPGA/HDL tools;
+# --cluster adds Slurm and munge for the ctest label cluster)
 set -euo pipefail
 
 packages=(build-essential cmake g++ libgtest-dev libgmock-dev libbenchmark-dev libsystemc-dev
-          nlohmann-json3-dev libyaml-cpp-dev python3 python3-numpy python3-scipy python3-matplotlib)
+          nlohmann-json3-dev libyaml-cpp-dev python3 python3-numpy python3-scipy python3-matplotlib
+          parallel)  # parallel: the GNU parallel sweep recipe and its test (docs/design-space.md)
 if [[ "${1:-}" == "--hardware" ]]; then
   packages+=(verilator iverilog yosys nextpnr-ice40 fpga-icestorm gtkwave)
+fi
+if [[ "${1:-}" == "--cluster" ]]; then
+  packages+=(slurm-wlm munge)
 fi
 
 missing=()

@@ -8,9 +8,11 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 jobs=$(nproc)
 # Labels: unit, hardware, postsynth run always; bitstream (place and route against the UP5K
 # targets, ~8 min on one core) in CI (CI=true) or with RANGING_BITSTREAM=1; soak only with
-# RANGING_SOAK=1.
+# RANGING_SOAK=1; cluster (a one-node Slurm cluster, root, ~25 s) only with RANGING_CLUSTER=1
+# (it installs slurm-wlm and munge).
 skip=()
 [[ "${RANGING_SOAK:-0}" == "1" ]] || skip+=(soak)
+if [[ "${RANGING_CLUSTER:-0}" == "1" ]]; then "$root/scripts/install-deps.sh" --cluster; else skip+=(cluster); fi
 [[ "${RANGING_BITSTREAM:-0}" == "1" || "${CI:-}" == "true" ]] || skip+=(bitstream)
 exclude=()
 if ((${#skip[@]})); then

@@ -119,6 +119,14 @@ std::optional<std::string> Parser::get(const std::string& name) const {
   return out;
 }
 
+std::vector<std::string> Parser::values(const std::string& name) const {
+  std::vector<std::string> out;
+  for (const auto& [n, v] : given_) {
+    if (n == name) out.push_back(v);
+  }
+  return out;
+}
+
 std::string Parser::get_or(const std::string& name, const std::string& fallback) const {
   return get(name).value_or(fallback);
 }

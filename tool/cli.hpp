@@ -31,6 +31,8 @@ class Parser {
   bool has(const std::string& name) const;  // flag given, or option given (not default)
   std::optional<std::string> get(const std::string& name) const;  // value or default
   std::string get_or(const std::string& name, const std::string& fallback) const;
+  // Every value of a repeatable option, in order (e.g. --set KEY=VALUE --set ...).
+  std::vector<std::string> values(const std::string& name) const;
   // Numeric options: validated to be finite and within [lo, hi]; the error names the option.
   double number(const std::string& name, double fallback, double lo, double hi) const;
   long long integer(const std::string& name, long long fallback, long long lo, long long hi) const;

@@ -47,12 +47,18 @@ int cmd_demo(const Args& args) {
   p.option("--gain", "FS", "received amplitude at 0.1 m in ADC full-scale units, 1e-6..10", "0.5");
   p.option("--noise-rms", "FS", "white noise rms at the ADC in full-scale units, 0..10", "0.002");
   p.option("--seed", "N", "noise seed", "1");
+  p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): correlator_fixed.chip_bits=18, filter.type=ellip (of --config, else of the built-in default)");
   p.flag("--json", "machine-readable output");
   p.flag("--quiet", "no progress on stderr");
   if (!p.parse(args)) return 0;
 
   DemoParams d;
-  if (auto cfg = p.get("--config"); cfg && p.has("--config")) d.receiver = load_receiver_config(*cfg);
+  const Overrides overrides = parse_overrides(p.values("--set"));
+  if (auto cfg = p.get("--config"); cfg && p.has("--config")) {
+    d.receiver = load_receiver_config(*cfg, overrides);
+  } else {
+    d.receiver = default_receiver_config(overrides);
+  }
   if (p.has("--family") || !p.has("--config")) d.receiver.family = p.get_or("--family", "Gold4");
   d.distances_m = parse_list("--distances", p.get_or("--distances", ""));
   d.speed_of_sound = p.number("--speed-of-sound", 340, 100, 10000);

@@ -18,15 +18,18 @@ int cmd_generate(const Args& args) {
   p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md)");
   p.option("--out", "DIR", "output folder");
   p.option("--origin", "NAME", "name of the configuration in the generated banners (default: FILE as given)");
+  p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): correlator_fixed.chip_bits=18, filter.type=ellip; the effective configuration is written as DIR/config.yaml");
   if (!p.parse(args)) return 0;
   const auto config = p.get("--config");
   const auto out = p.get("--out");
   if (!config) throw InputError("option --config is required");
   if (!out) throw InputError("option --out is required");
-  const ReceiverConfig cfg = load_receiver_config(*config);
+  const Overrides overrides = parse_overrides(p.values("--set"));
+  const ReceiverConfig cfg = load_receiver_config(*config, overrides);
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);
-  const auto files = generate_hardware_files(design, p.get_or("--origin", *config));
+  auto files = generate_hardware_files(design, p.get_or("--origin", *config));
+  if (!overrides.empty()) files["config.yaml"] = receiver_config_yaml(cfg);  // re-run: --config DIR/config.yaml
   write_hardware_files(files, *out);
   std::cout << "generated " << files.size() << " files for configuration '" << design.config.name
             << "' in " << *out << "\n";

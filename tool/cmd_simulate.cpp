@@ -149,15 +149,18 @@ int cmd_simulate(const Args& args) {
   cli::Parser p("ranging simulate",
                 "Run a scene (docs/scenes.md): build exactly the channel stages it names, send its\n"
                 "codes over its distances and decode them. Writes DIR/measurements.csv (one row per\n"
-                "measurement) and DIR/summary.json; prints the stages built and a summary.");
+                "measurement), DIR/summary.json and the effective scene (DIR/scene.yaml, and its\n"
+                "receiver configuration DIR/config.yaml: `ranging simulate DIR/scene.yaml` repeats the\n"
+                "run); prints the stages built and a summary.");
   p.positional("SCENE", "scene file (YAML)");
   p.option("--precision", "float|fixed", "receiver precision (overrides the scene's receiver.precision)");
   p.option("--out", "DIR", "output directory (created); default out/<scene name>");
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
+  p.option("--set", "KEY=VALUE", "override a key of the scene, a dotted YAML path (repeatable): noise.noise_v=0.01; receiver.config.KEY sets a key of its receiver configuration, e.g. receiver.config.correlator_fixed.chip_bits=18");
   p.flag("--quiet", "no progress bar");
   if (!p.parse(args)) return 0;
-  Scene scene = load_scene(p.positionals().at(0));
+  Scene scene = load_scene(p.positionals().at(0), parse_overrides(p.values("--set")));
   if (p.has("--precision")) {
     const std::string prec = *p.get("--precision");
     if (prec != "float" && prec != "fixed") {
@@ -195,6 +198,7 @@ int cmd_simulate(const Args& args) {
   const nlohmann::json summary = summary_json(sim, run);
   write_file_atomic(out + "/measurements.csv", measurements_csv(run, scene.speed()));
   write_file_atomic(out + "/summary.json", summary.dump(2) + "\n");
+  write_effective_scene(scene, out);  // DIR/scene.yaml (+ config.yaml): re-run with `simulate DIR/scene.yaml`
   if (p.has("--write-captures")) {
     fs::remove_all(out + "/captures", ec);
     fs::rename(staging, out + "/captures", ec);
@@ -209,7 +213,7 @@ int cmd_simulate(const Args& args) {
       std::printf("%-8s %4d %6zu %7zu %10.4f %8.4f %11.4g %9.1f %9.0f\n", f.family.c_str(), f.eta, f.measurements,
                   f.decode_errors, f.rmse_m * 1e3, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz);
     }
-    std::printf("\nwrote %s/measurements.csv, %s/summary.json%s\n", out.c_str(), out.c_str(),
+    std::printf("\nwrote %s/measurements.csv, %s/summary.json, %s/scene.yaml%s\n", out.c_str(), out.c_str(), out.c_str(),
                 p.has("--write-captures") ? (", " + out + "/captures/").c_str() : "");
   }
   return 0;

@@ -16,5 +16,7 @@ int cmd_simulate(const Args& args);  // run a scene (cmd_simulate.cpp)
 int cmd_evaluate(const Args& args);  // reproduce the paper's Section 4 (cmd_evaluate.cpp)
 int cmd_decode(const Args& args);    // decode a real capture (cmd_decode.cpp)
 int cmd_doppler(const Args& args);   // decode rate and ToF bias vs line-of-sight speed (cmd_doppler.cpp)
+int cmd_sweep(const Args& args);     // design-space sweep and merge (cmd_sweep.cpp)
+int cmd_wordlength(const Args& args);  // word-length optimization (cmd_wordlength.cpp)
 
 }  // namespace ranging::tool

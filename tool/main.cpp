@@ -31,6 +31,8 @@ constexpr Subcommand kSubcommands[] = {
      ranging::tool::cmd_evaluate},
     {"decode", "decode a recorded capture (oscilloscope CSV or WAV)", ranging::tool::cmd_decode},
     {"doppler", "decode rate and ToF bias against a constant line-of-sight speed", ranging::tool::cmd_doppler},
+    {"sweep", "design-space sweep: accuracy and cost over axes, Pareto fronts (docs/design-space.md)", ranging::tool::cmd_sweep},
+    {"wordlength", "smallest fixed-point widths within an accuracy tolerance (docs/design-space.md)", ranging::tool::cmd_wordlength},
 };
 
 void print_usage(std::ostream& os) {

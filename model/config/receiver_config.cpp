@@ -35,8 +35,9 @@ Overflow parse_overflow(Reader& r, const std::string& k, const std::string& s) {
 
 }  // namespace
 
-ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin) {
-  const YAML::Node root = yaml::load(yaml_text, origin);
+namespace {
+
+ReceiverConfig parse_document(YAML::Node root, const std::string& origin) {
   ReceiverConfig cfg;
   if (!root || root.IsNull()) throw InputError(origin + ": the configuration is empty");
   Reader top(root, origin, "");
@@ -118,12 +119,26 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
   return cfg;
 }
 
-ReceiverConfig load_receiver_config(const std::string& path) {
+}  // namespace
+
+ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin,
+                                     const Overrides& overrides) {
+  YAML::Node root = yaml::load(yaml_text, origin);
+  apply_overrides(root, overrides, origin);
+  return with_override_errors(overrides, origin, [&] { return parse_document(root, origin); });
+}
+
+ReceiverConfig default_receiver_config(const Overrides& overrides) {
+  if (overrides.empty()) return ReceiverConfig{};
+  return parse_receiver_config("", "(built-in default configuration)", overrides);
+}
+
+ReceiverConfig load_receiver_config(const std::string& path, const Overrides& overrides) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the configuration file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_receiver_config(ss.str(), path);
+  return parse_receiver_config(ss.str(), path, overrides);
 }
 
 std::string receiver_config_yaml(const ReceiverConfig& c) {

@@ -4,14 +4,20 @@
 // the file, line and key; the values are checked by validate() (model/dsp/receiver.hpp).
 #include <string>
 
+#include "model/config/overrides.hpp"
 #include "model/dsp/receiver.hpp"
 
 namespace ranging {
 
 // YAML (docs/configuration.md). Unknown keys, wrong types and out-of-range values are
 // errors naming the file, line and key.
-ReceiverConfig load_receiver_config(const std::string& path);
-ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin);
+// overrides (--set KEY=VALUE, model/config/overrides.hpp) are applied to the document before
+// it is parsed; their errors name the override.
+ReceiverConfig load_receiver_config(const std::string& path, const Overrides& overrides = {});
+ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin,
+                                     const Overrides& overrides = {});
+// An empty document with overrides: the built-in default configuration, overridden.
+ReceiverConfig default_receiver_config(const Overrides& overrides);
 std::string receiver_config_yaml(const ReceiverConfig& cfg);
 
 }  // namespace ranging

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "model/dsp/codes.hpp"
+#include "model/sim/capture.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/config/yaml_reader.hpp"
@@ -35,10 +36,22 @@ using yaml::Reader;
 using yaml::one_of;
 using yaml::section;
 
-}  // namespace
+// Errors of the configuration's overrides name them as the user wrote them (receiver.config.KEY).
+template <class F>
+auto config_errors(F&& load) -> decltype(load()) {
+  try {
+    return load();
+  } catch (const InputError& e) {
+    std::string m = e.what();
+    for (std::size_t at = m.find("--set "); at != std::string::npos; at = m.find("--set ", at + 6)) {
+      m.insert(at + 6, "receiver.config.");
+    }
+    throw InputError(m);
+  }
+}
 
-Scene parse_scene(const std::string& text, const std::string& origin, const std::string& base_dir) {
-  YAML::Node root = yaml::load(text, origin);
+Scene parse_document(YAML::Node root, const std::string& origin, const std::string& base_dir,
+                     const Overrides& config_overrides) {
   if (!root || root.IsNull()) throw InputError(origin + ": the scene is empty (it needs at least geometry.distances_m)");
   Scene s;
   s.origin = origin;
@@ -168,14 +181,26 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
     });
   });
 
+  bool config_loaded = false;
+  {
+    const YAML::Node croot = root;
+    const bool names_config = croot["receiver"] && croot["receiver"].IsMap() && croot["receiver"]["config"];
+    if (!names_config && !config_overrides.empty()) {
+      s.receiver.config = config_errors([&] { return default_receiver_config(config_overrides); });
+      s.effective_config_yaml = receiver_config_yaml(s.receiver.config);
+      config_loaded = true;
+    }
+  }
   section(top, "receiver", [&](Reader& r) {
     auto& rc = s.receiver;
     std::string cfg;
     if (r.get("config", cfg)) {
       std::filesystem::path p(cfg);
       if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
-      rc.config = load_receiver_config(p.string());
+      rc.config = config_errors([&] { return load_receiver_config(p.string(), config_overrides); });
+      config_loaded = true;
     }
+    if (config_loaded) s.effective_config_yaml = receiver_config_yaml(rc.config);
     std::string type;
     if (r.get("filter_type", type)) {
       try {
@@ -222,16 +247,58 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
   } catch (const InputError& e) {
     throw InputError(origin + ": " + e.what());
   }
+
+  // The effective scene document: paths made absolute (the configuration goes beside it).
+  s.effective_document = YAML::Clone(root);
+  YAML::Node eff = s.effective_document;
+  if (eff["receiver"] && eff["receiver"].IsMap() && eff["receiver"]["references_dir"] &&
+      !s.receiver.references_dir.empty()) {
+    eff["receiver"]["references_dir"] = std::filesystem::absolute(s.receiver.references_dir).string();
+  }
   return s;
 }
 
-Scene load_scene(const std::string& path) {
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& origin, const std::string& base_dir,
+                  const Overrides& overrides) {
+  YAML::Node root = yaml::load(text, origin);
+  const Overrides scene_overrides = overrides_not_under(overrides, "receiver.config");
+  const Overrides config_overrides = overrides_under(overrides, "receiver.config");
+  apply_overrides(root, scene_overrides, origin);
+  return with_override_errors(scene_overrides, origin,
+                              [&] { return parse_document(root, origin, base_dir, config_overrides); });
+}
+
+Scene load_scene(const std::string& path, const Overrides& overrides) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the scene file");
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return parse_scene(ss.str(), path, dir.empty() ? "." : dir);
+  return parse_scene(ss.str(), path, dir.empty() ? "." : dir, overrides);
+}
+
+std::string effective_scene_yaml(const Scene& scene, const std::string& config_file) {
+  YAML::Node eff = YAML::Clone(scene.effective_document);
+  if (!eff || !eff.IsMap()) eff = YAML::Node(YAML::NodeType::Map);
+  const bool has_config = !scene.effective_config_yaml.empty();
+  if (has_config) {
+    if (!eff["receiver"] || !eff["receiver"].IsMap()) eff["receiver"] = YAML::Node(YAML::NodeType::Map);
+    eff["receiver"]["config"] = config_file;
+  }
+  return "# Effective scene: " + scene.origin + " with its overrides; receiver configuration: " +
+         (has_config ? config_file + " beside this file" : std::string("built-in")) + "\n" + emit_yaml(eff);
+}
+
+std::vector<std::string> write_effective_scene(const Scene& scene, const std::string& dir, const std::string& prefix) {
+  std::vector<std::string> out{dir + "/" + prefix + "scene.yaml"};
+  write_file_atomic(out[0], effective_scene_yaml(scene, prefix + "config.yaml"));
+  if (!scene.effective_config_yaml.empty()) {
+    out.push_back(dir + "/" + prefix + "config.yaml");
+    write_file_atomic(out[1], scene.effective_config_yaml);
+  }
+  return out;
 }
 
 }  // namespace ranging

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "model/config/overrides.hpp"
 #include "model/sim/medium.hpp"
 #include "model/dsp/receiver.hpp"
 #include "model/sim/rotor.hpp"
@@ -96,13 +97,27 @@ struct Scene {
   SceneNoise noise;
   SceneReceiver receiver;
   double max_range_m = 0;           // L of eq. 3/4 (0: the largest distance)
+  // The effective documents (after --set overrides), written next to every output so a run can
+  // be repeated: the scene refers to its receiver configuration as "config.yaml" beside it.
+  YAML::Node effective_document;       // the scene document, paths made absolute
+  std::string effective_config_yaml;   // empty: the scene uses the built-in configuration
 
   double speed() const;             // c used by the channel and by the receiver's ToF -> d
   double range_l() const;
 };
 
-Scene load_scene(const std::string& path);
+// overrides (--set KEY=VALUE, model/config/overrides.hpp) apply to the scene document before it
+// is parsed; keys under "receiver.config." apply to the receiver configuration the scene
+// references (or to the built-in one), e.g. receiver.config.correlator_fixed.chip_bits=18.
+Scene load_scene(const std::string& path, const Overrides& overrides = {});
 // origin names the file in errors; base_dir resolves relative paths (receiver.config, ...).
-Scene parse_scene(const std::string& yaml_text, const std::string& origin, const std::string& base_dir = ".");
+Scene parse_scene(const std::string& yaml_text, const std::string& origin, const std::string& base_dir = ".",
+                  const Overrides& overrides = {});
+// The effective scene as YAML text, its receiver.config naming config_file (when it has one).
+std::string effective_scene_yaml(const Scene& scene, const std::string& config_file = "config.yaml");
+// Writes DIR/<prefix>scene.yaml and, if the scene has a configuration, DIR/<prefix>config.yaml
+// (atomically); returns the paths written.
+std::vector<std::string> write_effective_scene(const Scene& scene, const std::string& dir,
+                                               const std::string& prefix = "");
 
 }  // namespace ranging

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -50,6 +51,30 @@ std::uint64_t splitmix(std::uint64_t x) {
   x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
   return x ^ (x >> 31);
 }
+
+// FNV-1a, 64 bit, over the bytes of a value: a stable hash for the noise seeds.
+struct StableHash {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  void bytes(const void* p, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
+  }
+  void u64(std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) {
+      const unsigned char b = static_cast<unsigned char>(v >> (8 * i));  // little-endian on every host
+      bytes(&b, 1);
+    }
+  }
+  void f64(double v) {
+    std::uint64_t u = 0;
+    std::memcpy(&u, &v, sizeof u);
+    u64(v == 0.0 ? 0 : u);  // -0 and +0 alike
+  }
+  void str(const std::string& s) {
+    u64(s.size());
+    bytes(s.data(), s.size());
+  }
+};
 
 struct Sparse {
   long start = 0;              // sample index of y[0] (may be negative: clipped when added)
@@ -406,10 +431,6 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   const int eta = lk.design.family.eta();
   const std::vector<int> codes = codes_sent(s, eta);
   const bool periodic = s.excitation.schedule.mode == "periodic";
-  std::size_t family_index = 0;
-  for (std::size_t i = 0; i < s.excitation.families.size(); ++i) {
-    if (s.excitation.families[i] == family) family_index = i;
-  }
   // The trains: single mode sends each code alone; periodic sends codes in order every T.
   std::vector<std::vector<Burst>> trains;
   if (periodic) {
@@ -454,10 +475,20 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
             ms /= static_cast<double>(td.last - td.first + 1);
             sigma = std::sqrt(ms / std::pow(10.0, *s.noise.snr_db / 10.0));
           }
-          std::uint64_t seed = splitmix(s.noise.seed);
-          seed = splitmix(seed ^ (family_index + 1));
-          seed = splitmix(seed ^ (di + 1) * 0x100000001B3ull);
-          seed = splitmix(seed ^ (static_cast<std::uint64_t>(rep) << 20) ^ ti);
+          // The draws depend on the values of the measurement (seed, family, distance, repeat,
+          // the codes and times of its train), never on its place in a list: a measurement gives
+          // the same noise in any scene, sweep, shard or order.
+          StableHash hv;
+          hv.u64(s.noise.seed);
+          hv.str(family);
+          hv.f64(d);
+          hv.u64(static_cast<std::uint64_t>(rep));
+          hv.u64(train.size());
+          for (const auto& b : train) {
+            hv.u64(static_cast<std::uint64_t>(b.code));
+            hv.f64(b.tx_s);
+          }
+          const std::uint64_t seed = splitmix(hv.h);
           std::mt19937_64 rng(seed);
           std::normal_distribution<double> nd(0.0, sigma);
           for (double& v : x) v += nd(rng);

@@ -1,0 +1,629 @@
+#include "model/study/sweep.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+
+#include "model/base/error.hpp"
+#include "model/config/overrides.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/config/yaml_reader.hpp"
+#include "model/hw/hw_generator.hpp"
+#include "model/hw/hw_params.hpp"
+#include "model/sim/capture.hpp"
+#include "model/sim/scene.hpp"
+#include "model/sim/scene_simulator.hpp"
+
+namespace ranging::study {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 0xcbf29ce484222325ull) {
+  for (unsigned char c : s) h = (h ^ c) * 0x100000001b3ull;
+  return h;
+}
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+std::string hex16(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+std::string fmt_number(double v) {
+  if (std::abs(v - std::round(v)) < 1e-9 * std::max(1.0, std::abs(v))) {
+    return std::to_string(static_cast<long long>(std::llround(v)));
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+// The overrides of a point on the spec's scene: the base configuration, the fixed model, then
+// the point's keys (configuration keys under receiver.config., scene keys without "scene.").
+Overrides point_overrides(const SweepSpec& spec, const Params& params) {
+  Overrides ov{{"receiver.config", spec.config_path}, {"receiver.precision", "fixed"}};
+  Params sorted = params;  // the keys are distinct: their order changes nothing but messages
+  std::sort(sorted.begin(), sorted.end());
+  for (const auto& [k, v] : sorted) {
+    if (k.rfind("scene.", 0) == 0) {
+      ov.push_back({k.substr(6), v});
+    } else {
+      ov.push_back({"receiver.config." + k, v});
+    }
+  }
+  return ov;
+}
+
+}  // namespace
+
+json SweepSpec::json() const {
+  nlohmann::json axes_j = nlohmann::json::array();
+  for (const auto& a : axes) axes_j.push_back({{"key", a.key}, {"values", a.values}});
+  nlohmann::json j{{"name", name}, {"config", config_path}, {"scene", scene_path}, {"mode", mode}, {"axes", axes_j}};
+  if (mode == "random") {
+    j["points"] = points;
+    j["seed"] = seed;
+  }
+  return j;
+}
+
+SweepSpec load_sweep_spec(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the sweep spec");
+  const std::string text = slurp(path);
+  const YAML::Node root = yaml::load(text, path);
+  if (!root || root.IsNull()) throw InputError(path + ": the sweep spec is empty (it needs config, scene and axes)");
+  SweepSpec s;
+  s.origin = path;
+  yaml::Reader top(root, path, "");
+  const fs::path base = fs::absolute(fs::path(path)).parent_path();
+  auto resolve = [&](const std::string& k, std::string& out) {
+    std::string v;
+    if (!top.get(k, v)) throw InputError(path + ": " + k + ": missing (a file, relative to the spec)");
+    fs::path p(v);
+    if (p.is_relative()) p = base / p;
+    p = p.lexically_normal();
+    if (!fs::exists(p)) top.error(k, "'" + p.string() + "' does not exist");
+    out = p.string();
+  };
+  top.get("name", s.name);
+  resolve("config", s.config_path);
+  resolve("scene", s.scene_path);
+  top.get("mode", s.mode);
+  yaml::one_of(top, "mode", s.mode, {"grid", "one-at-a-time", "random"});
+  const bool has_points = top.get_range("points", s.points, 1, 100000);
+  long long seed = 1;
+  const bool has_seed = top.get_range("seed", seed, 0, 9.0e18);
+  s.seed = static_cast<std::uint64_t>(seed);
+  if (s.mode == "random" && !has_points) top.error("mode", "random needs points: N");
+  if (s.mode != "random" && (has_points || has_seed)) top.error(has_points ? "points" : "seed", "only for mode: random");
+  const YAML::Node axes = top.child("axes");
+  if (!axes || !axes.IsSequence() || axes.size() == 0) {
+    if (axes) yaml::fail(path, axes, "axes", "expected a non-empty list of {key, values | range}");
+    throw InputError(path + ": axes: missing; give a list of {key, values | range}");
+  }
+  top.finish();
+
+  // Each value is checked on its own against the base configuration or scene: an unknown key
+  // or a value out of range is refused here, naming the spec's line.
+  const ReceiverConfig base_cfg = load_receiver_config(s.config_path);
+  std::set<std::string> keys;
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    const std::string name = "axes[" + std::to_string(i) + "]";
+    yaml::Reader r(axes[i], path, name);
+    Axis a;
+    a.line = axes[i].Mark().line + 1;
+    if (!r.get("key", a.key) || a.key.empty()) r.error("key", "missing: a configuration key (correlator_fixed.chip_bits) or scene.<key>");
+    if (a.key == "scene.receiver.config" || a.key == "scene.receiver.precision" ||
+        a.key.rfind("scene.receiver.config.", 0) == 0) {
+      r.error("key", "'" + a.key + "' is set by the sweep (the spec's config, the fixed model); sweep the configuration's own keys");
+    }
+    if (!keys.insert(a.key).second) r.error("key", "'" + a.key + "' is a duplicate axis");
+    const bool has_values = r.has("values"), has_range = r.has("range");
+    if (has_values == has_range) r.error("key", "give values: [...] or range: {from, to, step}, one of them");
+    std::vector<YAML::Node> value_nodes;
+    if (has_values) {
+      const YAML::Node v = r.child("values");
+      if (!v.IsSequence() || v.size() == 0) yaml::fail(path, v, r.key("values"), "empty axis: give at least one value");
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        if (!v[k].IsScalar()) yaml::fail(path, v[k], r.key("values"), "expected scalars");
+        a.values.push_back(v[k].Scalar());
+        value_nodes.push_back(v[k]);
+      }
+    } else {
+      yaml::section(r, "range", [&](yaml::Reader& q) {
+        double from = 0, to = 0, step = 0;
+        if (!q.get("from", from) || !q.get("to", to) || !q.get("step", step)) q.error("from", "a range needs from, to and step");
+        if (!(step > 0)) q.error("step", "must be > 0");
+        if (to < from) q.error("to", "empty axis: to < from");
+        const double n = std::floor((to - from) / step + 1e-9) + 1;
+        if (n > 10000) q.error("step", "more than 10000 values");
+        for (int k = 0; k < static_cast<int>(n); ++k) {
+          a.values.push_back(fmt_number(from + k * step));
+          value_nodes.push_back(axes[i]["range"]);
+        }
+      });
+    }
+    std::set<std::string> seen;
+    for (std::size_t k = 0; k < a.values.size(); ++k) {
+      if (!seen.insert(a.values[k]).second) {
+        yaml::fail(path, value_nodes[k], r.key("values"), "'" + a.values[k] + "' appears twice");
+      }
+      try {
+        if (a.key.rfind("scene.", 0) == 0) {
+          (void)load_scene(s.scene_path, point_overrides(s, {{a.key, a.values[k]}}));
+        } else {
+          (void)parse_receiver_config(receiver_config_yaml(base_cfg), s.config_path, {{a.key, a.values[k]}});
+        }
+      } catch (const InputError& e) {
+        // The key's own check (unknown key, type, range) refuses the spec; a combination the
+        // design refuses (a coefficient that does not fit, ...) is a refused point instead.
+        const std::string what = e.what();
+        if (what.rfind("--set", 0) == 0) yaml::fail(path, value_nodes[k], a.key, "value '" + a.values[k] + "' refused: " + what);
+      }
+    }
+    r.finish();
+    s.axes.push_back(a);
+  }
+  (void)load_scene(s.scene_path, point_overrides(s, {}));  // the base point itself must load
+  return s;
+}
+
+std::string point_id(const Params& params) {
+  Params sorted = params;  // the same point in any axis order has the same id
+  std::sort(sorted.begin(), sorted.end());
+  std::string canon;
+  for (const auto& [k, v] : sorted) canon += k + "=" + v + "\n";
+  return hex16(splitmix(fnv1a(canon)));
+}
+
+std::vector<PointDef> sweep_points(const SweepSpec& spec) {
+  std::vector<PointDef> out{{point_id({}), {}}};
+  std::set<std::string> ids{out[0].id};
+  auto add = [&](const Params& p) {
+    const std::string id = point_id(p);
+    if (ids.insert(id).second) out.push_back({id, p});
+  };
+  if (spec.mode == "one-at-a-time") {
+    for (const auto& a : spec.axes) {
+      for (const auto& v : a.values) add({{a.key, v}});
+    }
+  } else if (spec.mode == "grid") {
+    std::vector<std::size_t> idx(spec.axes.size(), 0);
+    while (true) {
+      Params p;
+      for (std::size_t i = 0; i < spec.axes.size(); ++i) p.push_back({spec.axes[i].key, spec.axes[i].values[idx[i]]});
+      add(p);
+      std::size_t i = spec.axes.size();
+      while (i > 0) {
+        --i;
+        if (++idx[i] < spec.axes[i].values.size()) break;
+        idx[i] = 0;
+        if (i == 0) return out;
+      }
+      if (spec.axes.empty()) return out;
+    }
+  } else {  // random: each axis value drawn uniformly, seeded; duplicates skipped
+    std::size_t combos = 1;
+    for (const auto& a : spec.axes) combos = std::min<std::size_t>(combos * a.values.size(), 1u << 30);
+    const std::size_t want = std::min<std::size_t>(static_cast<std::size_t>(spec.points), combos);
+    for (std::uint64_t draw = 0; out.size() < want + 1 && draw < 1000 * want + 1000; ++draw) {
+      Params p;
+      for (std::size_t i = 0; i < spec.axes.size(); ++i) {
+        const std::uint64_t r = splitmix(splitmix(spec.seed ^ (draw * 0x9E3779B97F4A7C15ull)) ^ (i + 1));
+        p.push_back({spec.axes[i].key, spec.axes[i].values[r % spec.axes[i].values.size()]});
+      }
+      add(p);
+    }
+  }
+  return out;
+}
+
+bool in_shard(const PointDef& p, int i, int n) {
+  return static_cast<int>(std::stoull(p.id, nullptr, 16) % static_cast<std::uint64_t>(n)) == i;
+}
+
+namespace {
+
+json jnum(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+std::mutex synth_mutex;
+std::map<std::string, std::shared_ptr<std::mutex>> synth_locks;
+
+// iCE40 resources of the generated receiver top (yosys synth_ice40 -dsp), cached by the hash of
+// the generated RTL and the module sources.
+json synthesize(const std::map<std::string, std::string>& files, const PointOptions& o) {
+  const std::vector<std::string> modules = {"bandpass_sos.v", "correlator_bank.v", "peak_detector.v"};
+  std::string all = files.at("rtl/receiver_top.v");
+  for (const auto& m : modules) all += slurp(o.source_dir + "/rtl/" + m);
+  const std::string hash = hex16(fnv1a(all));
+  std::shared_ptr<std::mutex> lock;
+  {
+    std::lock_guard<std::mutex> g(synth_mutex);
+    auto& l = synth_locks[hash];
+    if (!l) l = std::make_shared<std::mutex>();
+    lock = l;
+  }
+  std::lock_guard<std::mutex> g(*lock);
+  const std::string cached = o.cache_dir + "/" + hash + ".json";
+  if (fs::exists(cached)) {
+    json j = json::parse(slurp(cached));
+    j["cached"] = true;
+    return j;
+  }
+  const std::string work = o.cache_dir + "/" + hash + ".work";
+  fs::remove_all(work);
+  fs::create_directories(work);
+  for (const auto& [name, text] : files) {
+    if (name.rfind("rtl/", 0) != 0) continue;
+    std::ofstream(work + "/" + fs::path(name).filename().string()) << text;
+  }
+  std::string cmd = "cd '" + work + "' && nice yosys -q -l yosys.log -p '";
+  for (const auto& m : modules) cmd += "read_verilog -defer " + o.source_dir + "/rtl/" + m + "; ";
+  cmd += "read_verilog -defer -I. receiver_top.v; hierarchy -top receiver_top; synth_ice40 -dsp -top receiver_top; "
+         "tee -q -o stat.txt stat' > /dev/null 2>&1";
+  const auto t0 = std::chrono::steady_clock::now();
+  if (std::system(cmd.c_str()) != 0) return json{{"synth_error", "yosys failed: see " + work + "/yosys.log"}};
+  json j{{"rtl_hash", hash}, {"lut4", 0}, {"dff", 0}, {"carry", 0}, {"mac16", 0}, {"ebr", 0}};
+  std::istringstream stat(slurp(work + "/stat.txt"));
+  std::string line;
+  while (std::getline(stat, line)) {
+    std::istringstream ls(line);
+    std::string cell;
+    long long n = 0;
+    if (!(ls >> cell >> n)) continue;
+    if (cell == "SB_LUT4") j["lut4"] = j["lut4"].get<long long>() + n;
+    else if (cell.rfind("SB_DFF", 0) == 0) j["dff"] = j["dff"].get<long long>() + n;
+    else if (cell == "SB_CARRY") j["carry"] = j["carry"].get<long long>() + n;
+    else if (cell == "SB_MAC16") j["mac16"] = j["mac16"].get<long long>() + n;
+    else if (cell.rfind("SB_RAM40", 0) == 0) j["ebr"] = j["ebr"].get<long long>() + n;
+  }
+  j["synth_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  write_file_atomic(cached, j.dump(2) + "\n");
+  fs::remove_all(work);
+  j["cached"] = false;
+  return j;
+}
+
+long long ceil16(long long bits) { return (bits + 15) / 16; }
+
+// The design's own throughput rule (rtl/bandpass_sos.v, rtl/correlator_bank.v headers): the
+// bandpass takes at most 6 clocks per sample, the bank's front end 6, its back end
+// 2 TAPS ceil(DEC_W/16) ceil(TAP_W/16) + 1 + CODES (2 ceil(CORR_W/16)^2 + ceil(2 CORR_W/16)
+// ceil(WEIGHT_W/16)) clocks per DECIM samples. The peak detector's group time is not part of
+// the rule (rtl/peak_detector.v bounds it only at the default widths).
+json throughput(const ReceiverDesign& d) {
+  const auto mods = hardware_parameters(d);
+  const HwModuleParams* bank = nullptr;
+  for (const auto& m : mods) {
+    if (m.module == "correlator_bank") bank = &m;
+  }
+  if (bank == nullptr) throw InputError("no correlator_bank parameters");
+  const long long taps = bank->value("TAPS"), dec_w = bank->value("DEC_W"), tap_w = bank->value("TAP_W"),
+                  codes = bank->value("CODES"), corr_w = bank->value("CORR_W"), weight_w = bank->value("WEIGHT_W"),
+                  decim = bank->value("DECIM");
+  const long long back = 2 * taps * ceil16(dec_w) * ceil16(tap_w) + 1 +
+                         codes * (2 * ceil16(corr_w) * ceil16(corr_w) + ceil16(2 * corr_w) * ceil16(weight_w));
+  const int available = d.config.sample_cycles();
+  const double back_per_sample = static_cast<double>(back) / static_cast<double>(decim);
+  const double needed = std::max(6.0, back_per_sample);
+  return json{{"clocks_per_sample_available", available}, {"clocks_per_sample_needed", needed},
+              {"bank_back_end_clocks_per_group", back}, {"decimation", decim},
+              {"real_time", needed <= available},
+              {"rule", "max(6 bandpass/front end, bank back end / DECIM) <= clock_hz / fs; peak detector not in the rule"}};
+}
+
+long long word_bits(const ReceiverConfig& c) {
+  const auto& b = c.bandpass;
+  const auto& k = c.correlator;
+  return b.input_bits + b.coef_bits + b.data_bits + b.acc_bits + k.lo_bits + k.mix_bits + k.tap_bits + k.chip_bits +
+         k.corr_bits + k.weight_bits + k.score_bits + c.detector.frac_bits;
+}
+
+}  // namespace
+
+json evaluate_point(const SweepSpec& spec, const PointDef& point, const PointOptions& options) {
+  json params = json::object();
+  for (const auto& [k, v] : point.params) params[k] = v;
+  json out{{"id", point.id}, {"params", params}, {"default", point.params.empty()}};
+  try {
+    Scene scene = load_scene(spec.scene_path, point_overrides(spec, point.params));
+    const ReceiverDesign design = design_receiver(scene.receiver.config);
+    check_generatable(design);
+    // Fixed model, timed.
+    SceneSimulator fixed(scene);
+    std::vector<Measurement> rows;
+    std::size_t fa_total = 0, samples = 0;
+    std::uint64_t overflows = 0;
+    double u_min = std::numeric_limits<double>::infinity();
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const auto& f : scene.excitation.families) {
+      std::size_t fa = 0;
+      std::uint64_t ovf = 0;
+      auto r = fixed.run(f, {}, [&](const CaptureStream& c) { samples += c.volts->size(); }, &fa, &ovf);
+      const FamilySummary s = summarize(scene, f, r, fa);
+      if (std::isfinite(s.u_min)) u_min = std::min(u_min, s.u_min);
+      fa_total += fa;
+      overflows += ovf;
+      rows.insert(rows.end(), r.begin(), r.end());
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // Float reference.
+    Scene fscene = scene;
+    fscene.receiver.precision = "float";
+    SceneSimulator flt(fscene);
+    std::vector<Measurement> frows;
+    for (const auto& f : scene.excitation.families) {
+      auto r = flt.run(f);
+      frows.insert(frows.end(), r.begin(), r.end());
+    }
+    std::size_t wrong = 0, missed = 0, correct = 0, disagree = 0;
+    double se = 0, max_err = 0, tof_dev = 0;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const Measurement& m = rows[i];
+      if (!m.detected) {
+        ++missed;
+      } else if (m.det.code != m.code_sent) {
+        ++wrong;
+      } else {
+        ++correct;
+        se += m.error_m * m.error_m;
+        max_err = std::max(max_err, std::abs(m.error_m));
+      }
+      const Measurement& f = frows.at(i);
+      if (m.detected && f.detected && m.det.code == f.det.code) {
+        tof_dev = std::max(tof_dev, std::abs(m.det.tof_s - f.det.tof_s));
+      } else if (m.detected != f.detected || m.det.code != f.det.code) {
+        ++disagree;
+      }
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out["accuracy"] = {{"measurements", rows.size()},
+                       {"decode_errors", wrong + missed + fa_total},
+                       {"wrong_code", wrong},
+                       {"missed", missed},
+                       {"false_alarms", fa_total},
+                       {"distance_rmse_m", jnum(correct ? std::sqrt(se / static_cast<double>(correct)) : nan)},
+                       {"max_abs_error_m", jnum(correct ? max_err : nan)},
+                       {"tof_max_deviation_from_float_s", tof_dev},
+                       {"float_disagreements", disagree},
+                       {"u_min", jnum(u_min)},
+                       {"overflows", overflows}};
+    json cost = throughput(design);
+    cost["word_bits"] = word_bits(scene.receiver.config);
+    if (options.synth) {
+      const auto files = generate_hardware_files(design, "sweep " + spec.name);
+      json syn = synthesize(files, options);
+      syn.erase("cached");
+      syn.erase("synth_seconds");
+      cost["ice40"] = syn;
+    }
+    out["cost"] = cost;
+    out["speed"] = {{"fixed_samples_per_s", seconds > 0 ? static_cast<double>(samples) / seconds : 0.0},
+                    {"samples", samples}};
+    out["status"] = "ok";
+  } catch (const InputError& e) {
+    out["status"] = "refused";
+    out["error"] = e.what();
+  }
+  return out;
+}
+
+namespace {
+
+double cost_of(const json& p) {
+  const json& c = p.at("cost");
+  if (c.contains("ice40") && c["ice40"].contains("lut4")) return c["ice40"]["lut4"].get<double>();
+  return c.at("word_bits").get<double>();
+}
+double rmse_of(const json& p) {
+  const json& v = p.at("accuracy").at("distance_rmse_m");
+  return v.is_null() ? std::numeric_limits<double>::infinity() : v.get<double>();
+}
+double errors_of(const json& p) { return p.at("accuracy").at("decode_errors").get<double>(); }
+
+void front(std::vector<json>& points, const std::string& flag, double (*b)(const json&)) {
+  for (auto& p : points) {
+    if (p.at("status") != "ok") {
+      p[flag] = false;
+      continue;
+    }
+    const double pa = cost_of(p), pb = b(p);
+    bool dominated = false;
+    for (const auto& q : points) {
+      if (&q == &p || q.at("status") != "ok") continue;
+      const double qa = cost_of(q), qb = b(q);
+      if (qa <= pa && qb <= pb && (qa < pa || qb < pb)) {
+        dominated = true;
+        break;
+      }
+    }
+    p[flag] = !dominated && std::isfinite(pb);
+  }
+}
+
+std::string cost_name(const std::vector<json>& points) {
+  for (const auto& p : points) {
+    if (p.at("status") == "ok") {
+      return p["cost"].contains("ice40") && p["cost"]["ice40"].contains("lut4") ? "lut4" : "word_bits";
+    }
+  }
+  return "word_bits";
+}
+
+std::string cell(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
+  if (v.is_number_float()) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9g", v.get<double>());
+    return buf;
+  }
+  return v.dump();
+}
+
+std::string csv_quote(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string o = "\"";
+  for (char c : s) o += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return o + "\"";
+}
+
+}  // namespace
+
+void mark_pareto(std::vector<json>& points) {
+  front(points, "pareto", rmse_of);
+  front(points, "pareto_errors", errors_of);
+}
+
+json sweep_document(const SweepSpec& spec, const std::vector<json>& points) {
+  json pts = json::array();
+  for (auto p : points) {
+    pts.push_back(p);
+  }
+  return json{{"spec", spec.json()}, {"cost_for_front", cost_name(points)}, {"points", pts}};
+}
+
+std::string points_csv(const std::vector<json>& points) {
+  std::set<std::string> keys_set;
+  std::vector<std::string> keys;
+  for (const auto& p : points) {
+    for (const auto& [k, v] : p.at("params").items()) {
+      if (keys_set.insert(k).second) keys.push_back(k);
+    }
+  }
+  const std::vector<std::string> acc = {"measurements", "decode_errors", "wrong_code", "missed", "false_alarms",
+                                        "distance_rmse_m", "max_abs_error_m", "tof_max_deviation_from_float_s",
+                                        "float_disagreements", "u_min", "overflows"};
+  const std::vector<std::string> cost = {"clocks_per_sample_needed", "clocks_per_sample_available", "real_time",
+                                         "word_bits"};
+  const std::vector<std::string> ice = {"lut4", "dff", "carry", "mac16", "ebr"};
+  std::ostringstream os;
+  os << "id,default,status";
+  for (const auto& k : keys) os << "," << k;
+  for (const auto& k : acc) os << "," << k;
+  for (const auto& k : cost) os << "," << k;
+  for (const auto& k : ice) os << ",ice40_" << k;
+  os << ",pareto,pareto_errors,error\n";
+  for (const auto& p : points) {
+    os << p.at("id").get<std::string>() << "," << cell(p.at("default")) << "," << p.at("status").get<std::string>();
+    for (const auto& k : keys) os << "," << (p["params"].contains(k) ? csv_quote(cell(p["params"][k])) : "");
+    const bool ok = p.at("status") == "ok";
+    for (const auto& k : acc) os << "," << (ok ? cell(p["accuracy"][k]) : "");
+    for (const auto& k : cost) os << "," << (ok ? cell(p["cost"][k]) : "");
+    for (const auto& k : ice) {
+      os << "," << (ok && p["cost"].contains("ice40") && p["cost"]["ice40"].contains(k) ? cell(p["cost"]["ice40"][k]) : "");
+    }
+    os << "," << cell(p.value("pareto", json(false))) << "," << cell(p.value("pareto_errors", json(false))) << ","
+       << csv_quote(p.value("error", std::string()));
+    os << "\n";
+  }
+  return os.str();
+}
+
+std::string summary_markdown(const SweepSpec& spec, const std::vector<json>& points) {
+  std::ostringstream os;
+  const std::string cname = cost_name(points);
+  std::size_t ok = 0, refused = 0;
+  for (const auto& p : points) (p.at("status") == "ok" ? ok : refused)++;
+  os << "# Sweep " << spec.name << "\n\n"
+     << "Generated by `ranging sweep " << spec.origin << "` (mode " << spec.mode << ", " << spec.axes.size()
+     << " axes): " << points.size() << " points, " << ok << " evaluated, " << refused << " refused.\n"
+     << "Base configuration `" << spec.config_path << "`, scene `" << spec.scene_path << "`, fixed model.\n\n"
+     << "Cost for the fronts: `" << cname << "`"
+     << (cname == "lut4" ? " (yosys synth_ice40 -dsp of the generated receiver top)"
+                         : " (sum of the configured word lengths: a proxy, run without --no-synth for LUT4)")
+     << ".\n\n## Points on a Pareto front\n\n"
+     << "| id | params | " << cname
+     << " | decode errors (wrong/missed/false) | RMSE mm | max mm | clocks/sample | real time | front |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
+  auto row = [&](const json& p) {
+    std::string params;
+    for (const auto& [k, v] : p["params"].items()) params += (params.empty() ? "" : ", ") + k + "=" + cell(v);
+    if (params.empty()) params = "(default)";
+    const auto& a = p["accuracy"];
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "| %s | %s | %.0f | %lld (%lld/%lld/%lld) | %s | %s | %.2f / %d | %s | %s%s |\n",
+                  p["id"].get<std::string>().c_str(), params.c_str(), cost_of(p), a["decode_errors"].get<long long>(),
+                  a["wrong_code"].get<long long>(), a["missed"].get<long long>(), a["false_alarms"].get<long long>(),
+                  a["distance_rmse_m"].is_null() ? "--" : (std::to_string(a["distance_rmse_m"].get<double>() * 1e3)).c_str(),
+                  a["max_abs_error_m"].is_null() ? "--" : (std::to_string(a["max_abs_error_m"].get<double>() * 1e3)).c_str(),
+                  p["cost"]["clocks_per_sample_needed"].get<double>(), p["cost"]["clocks_per_sample_available"].get<int>(),
+                  p["cost"]["real_time"].get<bool>() ? "yes" : "NO", p.value("pareto", false) ? "rmse " : "",
+                  p.value("pareto_errors", false) ? "errors" : "");
+    os << buf;
+  };
+  const json* def = nullptr;
+  for (const auto& p : points) {
+    if (p.at("default").get<bool>()) def = &p;
+    if (p.at("status") == "ok" && (p.value("pareto", false) || p.value("pareto_errors", false))) row(p);
+  }
+  os << "\n## The default configuration\n\n";
+  if (def && def->at("status") == "ok") {
+    os << "| id | params | " << cname << " | decode errors | RMSE mm | max mm | clocks/sample | real time | front |\n"
+       << "|---|---|---|---|---|---|---|---|---|\n";
+    row(*def);
+    if (!def->value("pareto", false)) {
+      for (const auto& p : points) {
+        if (p.at("status") != "ok" || &p == def) continue;
+        if (cost_of(p) <= cost_of(*def) && rmse_of(p) <= rmse_of(*def) &&
+            (cost_of(p) < cost_of(*def) || rmse_of(p) < rmse_of(*def))) {
+          os << "\nDominated on (" << cname << ", RMSE) by " << p["id"].get<std::string>() << ".\n";
+          break;
+        }
+      }
+    }
+  } else {
+    os << "The default point was not evaluated" << (def ? ": " + def->value("error", std::string()) : std::string()) << "\n";
+  }
+  if (refused) {
+    os << "\n## Refused points\n\n";
+    for (const auto& p : points) {
+      if (p.at("status") == "ok") continue;
+      std::string params;
+      for (const auto& [k, v] : p["params"].items()) params += (params.empty() ? "" : ", ") + k + "=" + cell(v);
+      os << "- " << p["id"].get<std::string>() << " (" << params << "): " << p.value("error", std::string()) << "\n";
+    }
+  }
+  os << "\n## Fixed model speed\n\n";
+  for (const auto& p : points) {
+    if (p.at("status") == "ok" && p.contains("speed")) {
+      char buf[128];
+      std::snprintf(buf, sizeof buf, "- %s: %.3g samples/s\n", p["id"].get<std::string>().c_str(),
+                    p["speed"]["fixed_samples_per_s"].get<double>());
+      os << buf;
+    }
+  }
+  return os.str();
+}
+
+void write_sweep_outputs(const std::string& dir, const SweepSpec& spec, const std::vector<json>& points) {
+  write_file_atomic(dir + "/sweep.json", sweep_document(spec, points).dump(2) + "\n");
+  write_file_atomic(dir + "/points.csv", points_csv(points));
+  write_file_atomic(dir + "/summary.md", summary_markdown(spec, points));
+}
+
+}  // namespace ranging::study

@@ -1,0 +1,78 @@
+#pragma once
+// Design-space sweeps (issue 11, docs/design-space.md): a spec names a base receiver
+// configuration, a scene and axes (a --set key with a list or a range of values); the axes
+// combine as a full grid, one at a time around the base, or N seeded random points. Each point
+// is the scene run in the fixed model (and the float model as the ToF reference) with the
+// point's overrides, plus its hardware cost: the design's throughput rule (clocks per sample
+// against clock_hz / fs) and, optionally, iCE40 resources from yosys synth_ice40 of the
+// generated receiver top, cached by the hash of the generated RTL.
+//
+// A point's id is a stable hash (FNV-1a 64) of its parameters: its shard (--shard I/N) and its
+// result never depend on its place in the sweep (the scene's noise draws do not either,
+// model/sim/scene_simulator.cpp). Results are deterministic except the measured speed.
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace ranging::study {
+
+struct Axis {
+  std::string key;                  // a configuration key, or "scene.<key>" for the scene
+  std::vector<std::string> values;  // YAML scalars, in the spec's order
+  int line = 0;                     // of the axis in the spec
+};
+
+struct SweepSpec {
+  std::string origin;        // the spec file, as given
+  std::string name = "sweep";
+  std::string config_path;   // absolute
+  std::string scene_path;    // absolute
+  std::string mode = "grid"; // grid | one-at-a-time | random
+  int points = 0;            // random: how many
+  std::uint64_t seed = 1;    // random: the sampling seed
+  std::vector<Axis> axes;
+  nlohmann::json json() const;  // canonical (paths as given in the spec are not kept: absolute)
+};
+
+// Strict: unknown keys, a value the configuration (or scene) refuses, an empty axis, duplicate
+// axes and a bad mode are InputErrors naming "file:line: key".
+SweepSpec load_sweep_spec(const std::string& path);
+
+using Params = std::vector<std::pair<std::string, std::string>>;  // axis order
+
+struct PointDef {
+  std::string id;       // 16 hex digits, stable hash of params
+  Params params;        // empty: the base (default) configuration
+};
+
+std::string point_id(const Params& params);
+// The points of the spec, in their canonical order: the base first, then the combination's.
+std::vector<PointDef> sweep_points(const SweepSpec& spec);
+// Whether the point belongs to shard i of n (by its id's hash).
+bool in_shard(const PointDef& p, int i, int n);
+
+struct PointOptions {
+  bool synth = true;
+  std::string cache_dir;    // synthesis results by RTL hash
+  std::string source_dir;   // the project (rtl/*.v)
+};
+
+// {"id", "params", "default", "status": "ok" | "refused", "error", "accuracy", "cost", "speed"}.
+// A configuration the model refuses is "refused" with its error, not an exception.
+nlohmann::json evaluate_point(const SweepSpec& spec, const PointDef& point, const PointOptions& options);
+
+// Sets "pareto" on every point: non-dominated on (lut4 or, without synthesis, the multiply
+// count estimate, distance RMSE) and on (the same cost, decode errors); refused points false.
+void mark_pareto(std::vector<nlohmann::json>& points);
+
+// DIR/sweep.json, DIR/points.csv, DIR/summary.md (points in the given order).
+void write_sweep_outputs(const std::string& dir, const SweepSpec& spec, const std::vector<nlohmann::json>& points);
+nlohmann::json sweep_document(const SweepSpec& spec, const std::vector<nlohmann::json>& points);
+std::string points_csv(const std::vector<nlohmann::json>& points);
+std::string summary_markdown(const SweepSpec& spec, const std::vector<nlohmann::json>& points);
+
+}  // namespace ranging::study
