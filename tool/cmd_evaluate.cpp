@@ -18,6 +18,7 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
+#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/scene_run.hpp"
 
@@ -61,9 +62,11 @@ int cmd_evaluate(const Args& args) {
   p.flag("--no-plots", "skip the PNG figures (no Python needed)");
   p.flag("--json", "print the tables as JSON on stdout");
   p.flag("--quiet", "no progress bar");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
   const std::string scene_path = p.positionals().at(0);
-  Scene scene = load_scene(scene_path);
+  Scene scene = load_scene(scene_path, p.has("--allow-out-of-spec"));
+  warn_if_out_of_spec("evaluate", scene.receiver.config);
   const std::string out = p.get_or("--out", "docs/results");
   namespace fs = std::filesystem;
   std::error_code ec;

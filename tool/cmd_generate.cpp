@@ -6,6 +6,7 @@
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
 #include "tool/cli.hpp"
+#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 
 namespace ranging::tool {
@@ -18,12 +19,14 @@ int cmd_generate(const Args& args) {
   p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md)");
   p.option("--out", "DIR", "output folder");
   p.option("--origin", "NAME", "name of the configuration in the generated banners (default: FILE as given)");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
   const auto config = p.get("--config");
   const auto out = p.get("--out");
   if (!config) throw InputError("option --config is required");
   if (!out) throw InputError("option --out is required");
-  const ReceiverConfig cfg = load_receiver_config(*config);
+  const ReceiverConfig cfg = load_receiver_config(*config, p.has("--allow-out-of-spec"));
+  warn_if_out_of_spec("generate", cfg);
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);
   const auto files = generate_hardware_files(design, p.get_or("--origin", *config));

@@ -17,6 +17,7 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
+#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/scene_run.hpp"
 
@@ -155,8 +156,10 @@ int cmd_simulate(const Args& args) {
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
   p.flag("--quiet", "no progress bar");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
-  Scene scene = load_scene(p.positionals().at(0));
+  Scene scene = load_scene(p.positionals().at(0), p.has("--allow-out-of-spec"));
+  warn_if_out_of_spec("simulate", scene.receiver.config);
   if (p.has("--precision")) {
     const std::string prec = *p.get("--precision");
     if (prec != "float" && prec != "fixed") {
@@ -187,7 +190,9 @@ int cmd_simulate(const Args& args) {
     fs::remove_all(staging, ec);
     throw;
   }
-  const nlohmann::json summary = summary_json(sim, run);
+  nlohmann::json summary = summary_json(sim, run);
+  // The guard's verdict on the receiver's quantized filter (refused at load unless allowed).
+  summary["design_guard"] = guard_json(check_quantized_design(scene.receiver.config), scene.receiver.config.filter_order);
   write_file_atomic(out + "/measurements.csv", measurements_csv(run, scene.speed()));
   write_file_atomic(out + "/summary.json", summary.dump(2) + "\n");
   if (p.has("--write-captures")) {

@@ -35,9 +35,10 @@ Overflow parse_overflow(Reader& r, const std::string& k, const std::string& s) {
 
 }  // namespace
 
-ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin) {
+ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin, bool allow_out_of_spec) {
   const YAML::Node root = yaml::load(yaml_text, origin);
   ReceiverConfig cfg;
+  cfg.allow_out_of_spec = allow_out_of_spec;
   if (!root || root.IsNull()) throw InputError(origin + ": the configuration is empty");
   Reader top(root, origin, "");
   top.get("name", cfg.name);
@@ -118,12 +119,12 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
   return cfg;
 }
 
-ReceiverConfig load_receiver_config(const std::string& path) {
+ReceiverConfig load_receiver_config(const std::string& path, bool allow_out_of_spec) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the configuration file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_receiver_config(ss.str(), path);
+  return parse_receiver_config(ss.str(), path, allow_out_of_spec);
 }
 
 std::string receiver_config_yaml(const ReceiverConfig& c) {

@@ -12,6 +12,7 @@
 
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
+#include "model/dsp/stability.hpp"
 
 namespace ranging {
 
@@ -121,6 +122,8 @@ ReceiverDesign design_receiver(const ReceiverConfig& cfg_in) {
                                   : design_bandpass(cfg.filter, cfg.filter_type);
   // Constructing the fixed filter validates its word lengths against the coefficients.
   BandpassFixed check(d.filter, cfg.bandpass);
+  // The guard on what the integer coefficients implement (unstable / out of spec: refused).
+  enforce_quantized_design(check_quantized_design(d), cfg);
 
   CorrelatorReference& ref = d.reference;
   ref.period = cfg.period();

@@ -42,6 +42,10 @@ struct ReceiverConfig {
   // hardware.clock_hz: the system clock the generated RTL is scheduled for (the iCEBreaker's
   // PLL makes it from 12 MHz); clock_hz / fs clocks per input sample, an integer.
   double clock_hz = 30e6;
+  // Study option, never read from or written to YAML: design_receiver refuses a design whose
+  // quantized filter is unstable or out of spec (model/dsp/stability.hpp) unless it is set
+  // (the tools' --allow-out-of-spec).
+  bool allow_out_of_spec = false;
 
   int period() const;        // fs / f, samples per carrier cycle (validated integer)
   int chip_samples() const;  // q fs / f

@@ -12,6 +12,7 @@
 #include "model/dsp/codes.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
+#include "model/dsp/stability.hpp"
 #include "model/config/yaml_reader.hpp"
 
 namespace ranging {
@@ -37,7 +38,8 @@ using yaml::section;
 
 }  // namespace
 
-Scene parse_scene(const std::string& text, const std::string& origin, const std::string& base_dir) {
+Scene parse_scene(const std::string& text, const std::string& origin, const std::string& base_dir,
+                  bool allow_out_of_spec) {
   YAML::Node root = yaml::load(text, origin);
   if (!root || root.IsNull()) throw InputError(origin + ": the scene is empty (it needs at least geometry.distances_m)");
   Scene s;
@@ -170,7 +172,7 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
     if (r.get("config", cfg)) {
       std::filesystem::path p(cfg);
       if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
-      rc.config = load_receiver_config(p.string());
+      rc.config = load_receiver_config(p.string(), allow_out_of_spec);
     }
     std::string type;
     if (r.get("filter_type", type)) {
@@ -209,8 +211,10 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
   rc.reference_transducer.centre_hz = s.transducers.centre_hz;
   rc.reference_transducer.q = s.transducers.q;
   fit_decimation_to_chip(rc);  // also per family in SceneSimulator (q_of)
+  rc.allow_out_of_spec = allow_out_of_spec;
   try {
     validate(rc);
+    enforce_quantized_design(rc);  // the filter at the scene's sample rate
     validate(TransducerParams{s.transducers.centre_hz, s.transducers.q, false}, s.fs);
     ExcitationParams ex{s.excitation.carrier_hz, s.excitation.cycles_per_chip, s.fs, 1.0};
     validate(ex);
@@ -220,13 +224,13 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
   return s;
 }
 
-Scene load_scene(const std::string& path) {
+Scene load_scene(const std::string& path, bool allow_out_of_spec) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the scene file");
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return parse_scene(ss.str(), path, dir.empty() ? "." : dir);
+  return parse_scene(ss.str(), path, dir.empty() ? "." : dir, allow_out_of_spec);
 }
 
 }  // namespace ranging

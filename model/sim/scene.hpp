@@ -99,8 +99,11 @@ struct Scene {
   double range_l() const;
 };
 
-Scene load_scene(const std::string& path);
+// allow_out_of_spec: accept a receiver whose quantized filter is unstable or out of spec
+// (model/dsp/stability.hpp; refused otherwise, naming the file).
+Scene load_scene(const std::string& path, bool allow_out_of_spec = false);
 // origin names the file in errors; base_dir resolves relative paths (receiver.config, ...).
-Scene parse_scene(const std::string& yaml_text, const std::string& origin, const std::string& base_dir = ".");
+Scene parse_scene(const std::string& yaml_text, const std::string& origin, const std::string& base_dir = ".",
+                  bool allow_out_of_spec = false);
 
 }  // namespace ranging
