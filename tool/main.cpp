@@ -30,6 +30,8 @@ constexpr Subcommand kSubcommands[] = {
     {"evaluate", "reproduce the paper's Section 4 evaluation (Tables 4-6, Figures 13-15)",
      ranging::tool::cmd_evaluate},
     {"decode", "decode a recorded capture (oscilloscope CSV or WAV)", ranging::tool::cmd_decode},
+    {"stability", "numerical stability report: guard, headroom, limit cycles, filter structures",
+     ranging::tool::cmd_stability},
 };
 
 void print_usage(std::ostream& os) {

@@ -53,6 +53,7 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
   section(top, "filter", [&](Reader& r) {
     r.get("type", type);
     r.get("order", cfg.filter_order);
+    r.get("structure", cfg.filter_structure);
     r.get("fp1", cfg.filter.fp1);
     r.get("fp2", cfg.filter.fp2);
     r.get("fs1", cfg.filter.fs1);

@@ -28,6 +28,9 @@ struct ReceiverConfig {
   BandpassSpec filter;                   // the paper's 150-250 kHz spec by default
   FilterType filter_type = FilterType::Butterworth;
   int filter_order = 0;                  // 0: the minimum order for the spec
+  // "sos" (the cascade the receiver and the hardware implement) or "direct" (one high-order
+  // recursion of the same design: a study structure, ranging stability; refused here).
+  std::string filter_structure = "sos";
   // Matched-filter reference (docs/architecture.md): "received" matches the response of the
   // transducers and the bandpass filter to one chip, as the paper's received templates do;
   // "ideal" matches the bare BPSK excitation.

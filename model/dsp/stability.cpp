@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 
 #include "model/base/error.hpp"
 #include "model/dsp/fixed_point.hpp"
@@ -245,6 +246,233 @@ void enforce_quantized_design(const DesignGuard& g, const ReceiverConfig& cfg) {
 void enforce_quantized_design(const ReceiverConfig& cfg) {
   if (cfg.allow_out_of_spec) return;
   enforce_quantized_design(check_quantized_design(cfg), cfg);
+}
+
+// ------------------------------------------------------------------ filter structures
+
+FilterStructure parse_filter_structure(const std::string& name) {
+  if (name == "sos") return FilterStructure::Sos;
+  if (name == "direct") return FilterStructure::Direct;
+  throw InputError("'" + name + "' is not a filter structure; valid: sos, direct");
+}
+std::string filter_structure_name(FilterStructure s) { return s == FilterStructure::Sos ? "sos" : "direct"; }
+
+namespace {
+std::vector<long double> poly_mul(const std::vector<long double>& p, const std::vector<long double>& q) {
+  std::vector<long double> r(p.size() + q.size() - 1, 0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t j = 0; j < q.size(); ++j) r[i + j] += p[i] * q[j];
+  }
+  return r;
+}
+using cld = std::complex<long double>;
+// p(z) and p'(z) by Horner, c[0] the leading coefficient.
+void horner(const std::vector<long double>& c, cld z, cld& p, cld& dp) {
+  p = c[0];
+  dp = 0;
+  for (std::size_t k = 1; k < c.size(); ++k) {
+    dp = dp * z + p;
+    p = p * z + c[k];
+  }
+}
+}  // namespace
+
+DirectForm direct_form(const SosFilter& filter) {
+  DirectForm d{{1.0L}, {1.0L}};
+  for (const Biquad& s : filter.sections) {
+    d.b = poly_mul(d.b, {s.b0, s.b1, s.b2});
+    d.a = poly_mul(d.a, {1.0L, s.a1, s.a2});
+  }
+  return d;
+}
+
+std::vector<cld> polynomial_roots(const std::vector<long double>& c_in) {
+  std::vector<long double> c = c_in;
+  while (c.size() > 1 && c.back() == 0) c.pop_back();  // roots at z = 0 handled below
+  const std::size_t zeros_at_origin = c_in.size() - c.size();
+  if (c.empty() || c[0] == 0) throw InputError("polynomial_roots: the leading coefficient is 0");
+  const std::size_t n = c.size() - 1;
+  std::vector<cld> z(n);
+  if (n > 0) {
+    const long double r0 = std::pow(std::abs(c[n] / c[0]), 1.0L / static_cast<long double>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+      z[i] = std::polar(r0, 2 * std::numbers::pi_v<long double> * static_cast<long double>(i) / n + 0.4L);
+    }
+    bool converged = false;
+    for (int it = 0; it < 2000 && !converged; ++it) {
+      converged = true;
+      for (std::size_t i = 0; i < n; ++i) {
+        cld p, dp;
+        horner(c, z[i], p, dp);
+        if (p == cld(0)) continue;
+        const cld ratio = p / dp;
+        cld sum = 0;
+        for (std::size_t j = 0; j < n; ++j) {
+          if (j != i) sum += 1.0L / (z[i] - z[j]);
+        }
+        const cld w = ratio / (1.0L - ratio * sum);
+        z[i] -= w;
+        // The evaluation of p near a cluster of roots limits the accuracy: for the 10th-order
+        // bandpass the corrections stagnate at ~1e-10 in long double.
+        if (std::abs(w) > 1e-9L * std::max(1.0L, std::abs(z[i]))) converged = false;
+      }
+    }
+    if (!converged) throw InputError("polynomial_roots: the Aberth iteration did not converge (degree " + std::to_string(n) + ")");
+
+  }
+  for (std::size_t i = 0; i < zeros_at_origin; ++i) z.emplace_back(0);
+  return z;
+}
+
+namespace {
+// Most fraction bits that let max |v| fit a signed `bits` word after rounding.
+int block_frac(const std::vector<long double>& v, int bits) {
+  long double m = 0;
+  for (long double x : v) m = std::max(m, std::abs(x));
+  int frac = 62;
+  while (frac > -62 && std::round(m * std::ldexp(1.0L, frac)) > std::ldexp(1.0L, bits - 1) - 1) --frac;
+  return frac;
+}
+std::vector<long double> quantize_block(const std::vector<long double>& v, int frac) {
+  std::vector<long double> q;
+  for (long double x : v) q.push_back(std::round(x * std::ldexp(1.0L, frac)) * std::ldexp(1.0L, -frac));
+  return q;
+}
+long double poly_attenuation(const std::vector<long double>& b, const std::vector<long double>& a, double f, double fs) {
+  const cld zi = std::polar(1.0L, -2 * std::numbers::pi_v<long double> * f / fs);  // z^-1
+  cld nb = 0, na = 0, zk = 1;
+  for (std::size_t k = 0; k < std::max(b.size(), a.size()); ++k) {
+    if (k < b.size()) nb += b[k] * zk;
+    if (k < a.size()) na += a[k] * zk;
+    zk *= zi;
+  }
+  return -20 * std::log10(std::abs(nb / na));
+}
+}  // namespace
+
+StructurePoint evaluate_structure(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int bits,
+                                  double tolerance_db) {
+  if (bits < 3 || bits > 60) throw InputError("coefficient bits: " + std::to_string(bits) + " is out of range; valid range is [3, 60]");
+  StructurePoint pt;
+  pt.bits = bits;
+  if (s == FilterStructure::Sos) {
+    const QuantizedSos q = quantize_sos(filter, bits, bits - 2, "");
+    const DesignGuard g = check_quantized_design(filter, q, spec, bits, tolerance_db);
+    pt.frac_a = pt.frac_b = bits - 2;
+    pt.max_radius = g.max_quantized_radius();
+    pt.stable = g.stable;
+    pt.within_spec = g.within_spec;
+    pt.passband_db = g.passband.quantized_db;
+    pt.stopband_db = g.stopband.quantized_db;
+    return pt;
+  }
+  const DirectForm d = direct_form(filter);
+  pt.frac_a = block_frac(d.a, bits);
+  pt.frac_b = block_frac(d.b, bits);
+  std::vector<long double> a = quantize_block(d.a, pt.frac_a);
+  const std::vector<long double> b = quantize_block(d.b, pt.frac_b);
+  a[0] = 1;  // implicit in the recursion y = sum b x - sum_{k>=1} a_k y[n-k]: never rounded
+  long double r = 0;
+  for (const cld& p : polynomial_roots(a)) r = std::max(r, std::abs(p));
+  pt.max_radius = static_cast<double>(r);
+  pt.stable = r < 1 - 1e-9L;
+  pt.passband_db = -1e300;
+  pt.stopband_db = 1e300;
+  constexpr int kPoints = 257;
+  for (int i = 0; i < kPoints; ++i) {
+    const double t = static_cast<double>(i) / (kPoints - 1);
+    pt.passband_db = std::max(pt.passband_db, static_cast<double>(poly_attenuation(b, a, spec.fp1 + (spec.fp2 - spec.fp1) * t, spec.fs)));
+    pt.stopband_db = std::min(pt.stopband_db, static_cast<double>(poly_attenuation(b, a, spec.fs1 / 256 + (spec.fs1 - spec.fs1 / 256) * t, spec.fs)));
+    pt.stopband_db = std::min(pt.stopband_db, static_cast<double>(poly_attenuation(b, a, spec.fs2 + (spec.fs / 2 - spec.fs2) * t, spec.fs)));
+  }
+  pt.within_spec = pt.stable && pt.passband_db <= spec.rp_db + tolerance_db && pt.stopband_db >= spec.rs_db - tolerance_db;
+  return pt;
+}
+
+int minimum_coefficient_bits(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int max_bits) {
+  for (int bits = 3; bits <= max_bits; ++bits) {
+    try {
+      if (evaluate_structure(filter, spec, s, bits).ok()) return bits;
+    } catch (const InputError&) {
+      // a coefficient does not fit at this width (SOS: |a1| >= 2 needs coef_frac < bits - 2)
+    }
+  }
+  return -1;
+}
+
+// ------------------------------------------------------------------ limit cycles
+
+std::string excitation_name(Excitation e) {
+  switch (e) {
+    case Excitation::Impulse: return "impulse";
+    case Excitation::Step: return "step";
+    case Excitation::WorstCase: return "worst-case";
+    case Excitation::Random: return "random";
+  }
+  return "?";
+}
+
+std::vector<std::int64_t> excitation_codes(Excitation e, const SosFilter& quantized, int input_bits, int length,
+                                           std::uint64_t seed) {
+  const std::int64_t lo = -(std::int64_t{1} << (input_bits - 1)), hi = -lo - 1;
+  std::vector<std::int64_t> x(static_cast<std::size_t>(length), 0);
+  if (x.empty()) return x;
+  switch (e) {
+    case Excitation::Impulse:
+      x[0] = lo;
+      break;
+    case Excitation::Step:
+      for (auto& v : x) v = lo;
+      break;
+    case Excitation::WorstCase: {
+      BandpassFloat f(quantized);
+      std::vector<double> h(x.size());
+      for (std::size_t n = 0; n < h.size(); ++n) h[n] = f.execute(n == 0 ? 1.0 : 0.0);
+      // y[N-1] = sum h[k] x[N-1-k] is largest in magnitude with x[N-1-k] = -sign(h[k]) * full scale.
+      for (std::size_t k = 0; k < h.size(); ++k) x[h.size() - 1 - k] = h[k] >= 0 ? lo : hi;
+      break;
+    }
+    case Excitation::Random: {
+      std::uint64_t st = seed * 0x9E3779B97F4A7C15ULL + 1;
+      for (auto& v : x) {
+        st ^= st << 13;
+        st ^= st >> 7;
+        st ^= st << 17;
+        v = lo + static_cast<std::int64_t>(st % static_cast<std::uint64_t>(hi - lo + 1));
+      }
+      break;
+    }
+  }
+  return x;
+}
+
+LimitCycle measure_limit_cycle(const SosFilter& filter, const BandpassFixedConfig& cfg,
+                               const std::vector<std::int64_t>& excitation, int settle, int observe) {
+  BandpassFixed f(filter, cfg);
+  if (settle < 0) {
+    long double r = 0;
+    for (const Biquad& b : f.quantized_filter().sections) r = std::max<long double>(r, pole_radius(b));
+    const double n = (r < 1 && r > 0) ? std::ceil(std::log(std::ldexp(1.0, -cfg.data_bits)) / std::log(static_cast<double>(r))) : 0;
+    settle = static_cast<int>(std::min(2 * n + 2000, 2e6));
+  }
+  for (std::int64_t x : excitation) f.execute_raw(x);
+  for (int n = 0; n < settle; ++n) f.execute_raw(0);
+  std::vector<std::int64_t> y(static_cast<std::size_t>(observe));
+  LimitCycle lc;
+  for (auto& v : y) {
+    v = f.execute_raw(0);
+    lc.amplitude_lsb = std::max(lc.amplitude_lsb, std::abs(static_cast<double>(v)));
+  }
+  lc.overflows = f.overflow_events().total();
+  for (int p = 1; p <= observe / 2; ++p) {
+    bool same = true;
+    for (std::size_t n = 0; n + static_cast<std::size_t>(p) < y.size() && same; ++n) same = y[n] == y[n + static_cast<std::size_t>(p)];
+    if (same) {
+      lc.period = p;
+      break;
+    }
+  }
+  return lc;
 }
 
 }  // namespace ranging

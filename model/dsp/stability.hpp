@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "model/dsp/bandpass_filter.hpp"
 #include "model/dsp/filter_design.hpp"
 #include "model/dsp/sos.hpp"
 
@@ -104,5 +105,68 @@ std::string guard_message(const DesignGuard& g, int filter_order);
 // cfg.allow_out_of_spec is set.
 void enforce_quantized_design(const ReceiverConfig& cfg);
 void enforce_quantized_design(const DesignGuard& g, const ReceiverConfig& cfg);
+
+// ------------------------------------------------------------------ filter structures
+// The same design as one high-order recursion (direct form, study only: the receiver and the
+// hardware implement the SOS cascade):
+//   H(z) = (sum_k b_k z^-k) / (sum_k a_k z^-k),  a_0 = 1, degree 2 * order,
+// the products of the sections' polynomials, expanded in long double. Quantized with B bits
+// per polynomial in block floating point: each polynomial gets the most fraction bits that let
+// its largest coefficient fit B signed bits (the numerator's gain ~1e-5 would vanish otherwise).
+// Poles: the roots of the quantized denominator (polynomial_roots); "stable" = all radii
+// < 1 - 1e-9 (a root finder, accurate to ~1e-10 here; not an exact test like the SOS one).
+enum class FilterStructure { Sos, Direct };
+FilterStructure parse_filter_structure(const std::string& name);  // "sos" | "direct"
+std::string filter_structure_name(FilterStructure s);
+
+struct DirectForm {
+  std::vector<long double> b, a;  // a[0] = 1
+};
+DirectForm direct_form(const SosFilter& filter);
+
+// Roots of c[0] z^n + c[1] z^(n-1) + ... + c[n] (c[0] != 0), Aberth-Ehrlich iteration in long
+// double from points on the circle of the roots' geometric mean radius, until every
+// correction is below 1e-9 relative (clustered roots limit the accuracy to about that).
+// Throws InputError if c[0] == 0 or the iteration does not converge.
+std::vector<std::complex<long double>> polynomial_roots(const std::vector<long double>& c);
+
+struct StructurePoint {   // one structure and coefficient word length
+  int bits = 0;
+  int frac_a = 0, frac_b = 0;  // fraction bits of the denominator and numerator words
+  double max_radius = 0;       // quantized poles
+  bool stable = false, within_spec = false;
+  double passband_db = 0, stopband_db = 0;  // worst over the band grids (quantized)
+  bool ok() const { return stable && within_spec; }
+};
+// SOS: coef_frac = bits - 2 (a1 in [-2, 2)), exact poles; direct: block floating point.
+// Throws InputError if bits is outside 3..60.
+StructurePoint evaluate_structure(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int bits,
+                                  double tolerance_db = kSpecToleranceDb);
+// Smallest bits in 3..max_bits with ok(), or -1.
+int minimum_coefficient_bits(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int max_bits = 60);
+
+// ------------------------------------------------------------------ limit cycles
+// Zero-input behaviour of the bit-accurate cascade (BandpassFixed, its public API): an
+// excitation of `length` samples, then zeros for `settle` samples (default: twice the
+// float response's decay to LSB/2 plus 2000, as docs/fixed-point.md), then `observe` more
+// samples in which the output's steady state is measured:
+//   amplitude_lsb = max |y| (data LSB) over the observation window;
+//   period        = smallest p such that y[n + p] = y[n] over the window (1 for a constant,
+//                   e.g. 0: the filter came to rest); 0 if it does not repeat within observe/2.
+enum class Excitation { Impulse, Step, WorstCase, Random };
+std::string excitation_name(Excitation e);  // "impulse", "step", "worst-case", "random"
+
+struct LimitCycle {
+  double amplitude_lsb = 0;
+  int period = 0;
+  std::uint64_t overflows = 0;  // section-output overflow events during the whole run
+};
+// Full-scale excitations of the input word: impulse -2^(B-1) at n = 0; step of -2^(B-1) for
+// `length` samples; worst case = the full-scale sign sequence of the float cascade's time-
+// reversed impulse response (the L1 input of the output node); random = uniform codes (seed).
+std::vector<std::int64_t> excitation_codes(Excitation e, const SosFilter& quantized, int input_bits, int length,
+                                           std::uint64_t seed = 1);
+LimitCycle measure_limit_cycle(const SosFilter& filter, const BandpassFixedConfig& cfg,
+                               const std::vector<std::int64_t>& excitation, int settle = -1, int observe = 4096);
 
 }  // namespace ranging
