@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -246,6 +247,184 @@ TEST(StabilityCli, SimulateAndEvaluateRefuseABadReceiverInTheScene) {
   fs::remove_all(out);
   fs::remove(cfg);
   fs::remove(scene);
+}
+
+}  // namespace
+}  // namespace ranging
+
+namespace ranging {
+namespace {
+
+// numpy's roots of the given coefficient lists (descending powers): their moduli, sorted.
+std::vector<std::vector<double>> numpy_root_radii(const std::vector<std::vector<long double>>& polys) {
+  std::ostringstream py;
+  py.precision(21);
+  py << "import numpy as np, json; P = [";
+  for (const auto& p : polys) {
+    py << "[";
+    for (long double c : p) py << static_cast<double>(c) << ",";
+    py << "],";
+  }
+  py << "]; print(json.dumps([sorted(abs(np.roots(p)).tolist()) for p in P]))";
+  const fs::path script = write_file("roots2.py", py.str());
+  const auto r = run_command(std::string(RANGING_PYTHON) + " " + script.string());
+  fs::remove(script);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return nlohmann::json::parse(r.out).get<std::vector<std::vector<double>>>();
+}
+
+std::vector<double> sorted_radii(const std::vector<std::complex<long double>>& z) {
+  std::vector<double> r;
+  for (const auto& v : z) r.push_back(static_cast<double>(std::abs(v)));
+  std::sort(r.begin(), r.end());
+  return r;
+}
+
+TEST(StabilityStructures, DirectFormRootsMatchNumpyAndTheSectionPoles) {
+  std::vector<std::vector<long double>> polys;
+  std::vector<SosFilter> filters;
+  for (FilterType t : {FilterType::Butterworth, FilterType::Chebyshev1, FilterType::Elliptic}) {
+    filters.push_back(design_bandpass(BandpassSpec{}, t));
+    const DirectForm d = direct_form(filters.back());
+    polys.push_back(d.a);
+    // The same polynomial with 32-bit block-floating-point coefficients (frac 23 for |a| < 256).
+    std::vector<long double> q = d.a;
+    for (auto& c : q) c = std::round(c * std::ldexp(1.0L, 23)) * std::ldexp(1.0L, -23);
+    polys.push_back(q);
+  }
+  const auto np = numpy_root_radii(polys);
+  ASSERT_EQ(np.size(), polys.size());
+  for (std::size_t i = 0; i < polys.size(); ++i) {
+    const std::vector<double> ours = sorted_radii(polynomial_roots(polys[i]));
+    ASSERT_EQ(ours.size(), np[i].size());
+    // Clustered roots: both evaluations are limited by the conditioning, to ~1e-8 here.
+    for (std::size_t k = 0; k < ours.size(); ++k) EXPECT_NEAR(ours[k], np[i][k], 1e-6) << i << " " << k;
+  }
+  // The expanded product's roots are the sections' poles.
+  for (const SosFilter& f : filters) {
+    double rmax = 0;
+    for (const Biquad& b : f.sections) rmax = std::max(rmax, pole_radius(b));
+    EXPECT_NEAR(sorted_radii(polynomial_roots(direct_form(f).a)).back(), rmax, 1e-8);
+  }
+}
+
+TEST(StabilityStructures, DirectFormNeedsFarMoreBitsAndIsUnstableAt32) {
+  const BandpassSpec spec;
+  for (FilterType t : {FilterType::Butterworth, FilterType::Chebyshev1, FilterType::Elliptic}) {
+    const SosFilter f = design_bandpass(spec, t);
+    const int sos = minimum_coefficient_bits(f, spec, FilterStructure::Sos);
+    const int direct = minimum_coefficient_bits(f, spec, FilterStructure::Direct);
+    ASSERT_GT(sos, 3) << filter_type_name(t);
+    EXPECT_TRUE(evaluate_structure(f, spec, FilterStructure::Sos, sos).ok());
+    EXPECT_FALSE(evaluate_structure(f, spec, FilterStructure::Sos, sos - 1).ok());
+    EXPECT_TRUE(evaluate_structure(f, spec, FilterStructure::Direct, direct).ok());
+    EXPECT_GT(direct, sos + 8) << filter_type_name(t);
+  }
+  // Butterworth order 5 as one 10th-order recursion: unstable even with 32-bit coefficients.
+  const StructurePoint p = evaluate_structure(design_bandpass(spec, FilterType::Butterworth), spec, FilterStructure::Direct, 32);
+  EXPECT_EQ(p.frac_a, 23);
+  EXPECT_FALSE(p.stable);
+  EXPECT_GT(p.max_radius, 1.0);
+}
+
+TEST(StabilityStructures, TheReceiverRefusesTheDirectStructure) {
+  try {
+    parse_receiver_config("filter:\n  structure: direct\n", "d.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("filter.structure: 'direct' is a study structure"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(parse_receiver_config("filter:\n  structure: lattice\n", "d.yaml"), InputError);
+  EXPECT_NO_THROW(parse_receiver_config("filter:\n  structure: sos\n", "d.yaml"));
+}
+
+// ------------------------------------------------------------------ limit cycles
+// docs/fixed-point.md: after settling the output is bounded by floor(noise_bound/LSB + 1/2)
+// (319 LSB for the defaults) and measured at <= 30 LSB (truncate) / 4 LSB (rounding).
+TEST(StabilityLimitCycles, TheDocumentedBoundsHoldForEveryModeAndExcitation) {
+  const ReceiverConfig cfg;
+  BandpassSpec spec = cfg.filter;
+  spec.fs = cfg.fs;
+  const SosFilter f = design_bandpass(spec, cfg.filter_type);
+  for (Rounding r : {Rounding::Truncate, Rounding::RoundHalfUp, Rounding::Convergent}) {
+    BandpassFixedConfig c = cfg.bandpass;
+    c.rounding = r;
+    const BandpassHeadroom h = bandpass_headroom(c, f);
+    const double bound = std::floor(h.noise_bound.back() * std::ldexp(1.0, c.data_frac) + 0.5);
+    const double measured_claim = r == Rounding::Truncate ? 30 : 4;
+    BandpassFixed probe(f, c);
+    for (Excitation e : {Excitation::Impulse, Excitation::Step, Excitation::WorstCase, Excitation::Random}) {
+      const LimitCycle lc = measure_limit_cycle(f, c, excitation_codes(e, probe.quantized_filter(), c.input_bits, 2000));
+      EXPECT_LE(lc.amplitude_lsb, bound) << excitation_name(e);
+      EXPECT_LE(lc.amplitude_lsb, measured_claim) << excitation_name(e);
+      EXPECT_EQ(lc.overflows, 0u);
+      EXPECT_GE(lc.period, 1) << "a steady state within the window";
+    }
+  }
+}
+
+// An all-pole section driven past its output word: wrap sustains a near full-scale overflow
+// oscillation after the input stops; saturation leaves only the granular deadband
+// |y| <= LSB/2 / (1 - a2) (Jackson's bound for rounding).
+TEST(StabilityLimitCycles, WrapSustainsAFullScaleOscillationAndSaturationCannot) {
+  const SosFilter f = design_bandpass(BandpassSpec{}, FilterType::Butterworth);
+  const Biquad& s5 = f.sections[4];
+  SosFilter one = f;
+  one.sections = {Biquad{1, 0, 0, s5.a1, s5.a2}};
+  BandpassFixedConfig c;
+  c.data_bits = 8;
+  c.data_frac = 6;
+  c.input_bits = 7;
+  c.acc_bits = 40;
+  c.overflow = Overflow::Wrap;
+  BandpassFixed probe(one, c);
+  const double full = static_cast<double>(fx_max_raw(probe.data_format()));
+  const auto x = excitation_codes(Excitation::Impulse, probe.quantized_filter(), c.input_bits, 2000);
+  const LimitCycle wrap = measure_limit_cycle(one, c, x);
+  EXPECT_GE(wrap.amplitude_lsb, 0.75 * full);
+  EXPECT_GT(wrap.period, 1);
+  EXPECT_GT(wrap.overflows, 1000u) << "it keeps overflowing with zero input";
+  c.overflow = Overflow::Saturate;
+  const double a2 = static_cast<double>(probe.coefficients()[0][4]) * std::ldexp(1.0, -c.coef_frac);
+  for (Excitation e : {Excitation::Impulse, Excitation::Step, Excitation::WorstCase, Excitation::Random}) {
+    const LimitCycle sat = measure_limit_cycle(one, c, excitation_codes(e, probe.quantized_filter(), c.input_bits, 2000));
+    EXPECT_LE(sat.amplitude_lsb, 0.5 / (1 - a2)) << excitation_name(e);
+  }
+}
+
+// ------------------------------------------------------------------ ranging stability
+TEST(StabilityCli, ReportOnTheDefaultShowsNoOverflowAndThePoles) {
+  const auto r = run_tool("stability --quick --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j.at("guard").at("ok").get<bool>());
+  ASSERT_EQ(j.at("headroom").size(), 5u);
+  for (const auto& h : j.at("headroom")) {
+    EXPECT_EQ(h.at("overflows").get<int>(), 0);
+    EXPECT_LE(h.at("measured_peak").get<double>(), h.at("peak_bound").get<double>());
+    EXPECT_GT(h.at("measured_peak").get<double>(), 0.99 * h.at("l1_gain").get<double>()) << "the worst case is reached";
+    EXPECT_GT(h.at("headroom_bits").get<double>(), 0);
+  }
+  EXPECT_EQ(j.at("limit_cycles").size(), 24u);
+  bool wrap_oscillates = false;
+  for (const auto& o : j.at("overflow_oscillations")) {
+    if (o.at("overflow") == "wrap" && o.at("amplitude_lsb").get<double>() > 0.5 * o.at("full_scale_lsb").get<double>()) {
+      wrap_oscillates = true;
+    }
+    if (o.at("overflow") == "saturate") {
+      EXPECT_LT(o.at("amplitude_lsb").get<double>(), 100);
+    }
+  }
+  EXPECT_TRUE(wrap_oscillates);
+}
+
+TEST(StabilityCli, ReportStudiesAnOutOfSpecConfigurationInsteadOfRefusingIt) {
+  const fs::path cfg = write_file("report6.yaml", kCoef6);
+  const auto r = run_tool("stability --quick --config " + cfg.string());
+  fs::remove(cfg);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("guard: FAILS: bandpass_fixed.coef_bits: 6"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("UNSTABLE"), std::string::npos);
 }
 
 }  // namespace

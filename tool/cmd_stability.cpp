@@ -153,6 +153,32 @@ int cmd_stability(const Args& args) {
   }
   j["limit_cycles"] = lcs;
 
+  // Overflow oscillations: each section alone as the all-pole recursion 1/A_k (unscaled, so a
+  // full-scale input overflows its output word), wrap vs saturate, the configuration's words.
+  json osc = json::array();
+  for (std::size_t k = 0; k < filter.sections.size(); ++k) {
+    SosFilter one = filter;
+    one.sections = {Biquad{1, 0, 0, filter.sections[k].a1, filter.sections[k].a2}};
+    for (Overflow o : kOverflows) {
+      BandpassFixedConfig c = bc;
+      c.overflow = o;
+      c.acc_bits = std::max(c.acc_bits, bandpass_min_acc_bits(c, one));
+      BandpassFixed probe(one, c);
+      double amp = 0;
+      int period = 0;
+      for (Excitation e : kExcitations) {
+        const LimitCycle lc = measure_limit_cycle(one, c, excitation_codes(e, probe.quantized_filter(), c.input_bits, kExcitationLength));
+        if (lc.amplitude_lsb >= amp) {
+          amp = lc.amplitude_lsb;
+          period = lc.period;
+        }
+      }
+      osc.push_back({{"section", k + 1}, {"overflow", overflow_str(o)}, {"amplitude_lsb", amp}, {"period", period},
+                     {"full_scale_lsb", static_cast<double>(fx_max_raw(probe.data_format()))}});
+    }
+  }
+  j["overflow_oscillations"] = osc;
+
   if (!p.has("--quick")) {
     // Amplitude (worst over the excitations) against the data width (coefficients as
     // configured) and against the coefficient width (data as configured), saturating.
@@ -238,6 +264,13 @@ int cmd_stability(const Args& args) {
                   l["rounding"].get<std::string>().c_str(), l["overflow"].get<std::string>().c_str(),
                   l["excitation"].get<std::string>().c_str(), l["amplitude_lsb"].get<double>(), l["period"].get<int>(),
                   static_cast<unsigned long long>(l["overflows"].get<std::uint64_t>()));
+    os << buf;
+  }
+  os << "\noverflow oscillations: each section alone as 1/A_k, full-scale excitations, then zeros\n"
+        "(worst amplitude in LSB of a full scale of " << osc[0]["full_scale_lsb"].get<double>() << "):\n";
+  for (const auto& o : osc) {
+    std::snprintf(buf, sizeof buf, "  section %d  %-9s %8.0f LSB  period %5d\n", o["section"].get<int>(),
+                  o["overflow"].get<std::string>().c_str(), o["amplitude_lsb"].get<double>(), o["period"].get<int>());
     os << buf;
   }
   if (j.contains("structures")) {
