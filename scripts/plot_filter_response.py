@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """|H(f)| of the float and the quantized bandpass design over the spec mask.
 
 Called by `ranging filter --plot FILE.png`: argv[1] is the JSON the tool wrote (frequencies,

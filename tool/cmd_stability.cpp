@@ -219,7 +219,8 @@ int cmd_stability(const Args& args) {
           pts.push_back({{"bits", b}, {"max_radius", pt.max_radius}, {"stable", pt.stable}, {"within_spec", pt.within_spec}});
         }
         st.push_back({{"type", filter_type_name(t)}, {"order", f.order}, {"structure", filter_structure_name(s)},
-                      {"min_bits", minimum_coefficient_bits(f, spec, s)}, {"points", pts}});
+                      {"min_bits", minimum_coefficient_bits(f, spec, s)},
+                      {"min_bits_every_wider", minimum_coefficient_bits(f, spec, s, 60, true)}, {"points", pts}});
       }
     }
     j["structures"] = st;
@@ -291,8 +292,9 @@ int cmd_stability(const Args& args) {
     os << "\nfilter structures: smallest coefficient bits that keep every pole inside the unit circle\n"
           "and meet the spec (tolerance " << guard.tolerance_db << " dB):\n";
     for (const auto& s : j["structures"]) {
-      std::snprintf(buf, sizeof buf, "  %-7s order %2d  %-6s  %3d bits\n", s["type"].get<std::string>().c_str(),
-                    s["order"].get<int>(), s["structure"].get<std::string>().c_str(), s["min_bits"].get<int>());
+      std::snprintf(buf, sizeof buf, "  %-7s order %2d  %-6s  %3d bits (every width from %d bits on)\n",
+                    s["type"].get<std::string>().c_str(), s["order"].get<int>(), s["structure"].get<std::string>().c_str(),
+                    s["min_bits"].get<int>(), s["min_bits_every_wider"].get<int>());
       os << buf;
     }
   }

@@ -389,15 +389,24 @@ StructurePoint evaluate_structure(const SosFilter& filter, const BandpassSpec& s
   return pt;
 }
 
-int minimum_coefficient_bits(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int max_bits) {
-  for (int bits = 3; bits <= max_bits; ++bits) {
+int minimum_coefficient_bits(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int max_bits,
+                             bool every_wider) {
+  auto ok = [&](int bits) {
     try {
-      if (evaluate_structure(filter, spec, s, bits).ok()) return bits;
+      return evaluate_structure(filter, spec, s, bits).ok();
     } catch (const InputError&) {
-      // a coefficient does not fit at this width (SOS: |a1| >= 2 needs coef_frac < bits - 2)
+      return false;  // a coefficient does not fit at this width
     }
+  };
+  if (!every_wider) {
+    for (int bits = 3; bits <= max_bits; ++bits) {
+      if (ok(bits)) return bits;
+    }
+    return -1;
   }
-  return -1;
+  int from = -1;
+  for (int bits = max_bits; bits >= 3 && ok(bits); --bits) from = bits;
+  return from;
 }
 
 // ------------------------------------------------------------------ limit cycles

@@ -142,8 +142,10 @@ struct StructurePoint {   // one structure and coefficient word length
 // Throws InputError if bits is outside 3..60.
 StructurePoint evaluate_structure(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int bits,
                                   double tolerance_db = kSpecToleranceDb);
-// Smallest bits in 3..max_bits with ok(), or -1.
-int minimum_coefficient_bits(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int max_bits = 60);
+// Smallest bits in 3..max_bits with ok(), or -1. Quantization error is not monotonic in the
+// word length: with every_wider, the smallest B such that every width B..max_bits is ok.
+int minimum_coefficient_bits(const SosFilter& filter, const BandpassSpec& spec, FilterStructure s, int max_bits = 60,
+                             bool every_wider = false);
 
 // ------------------------------------------------------------------ limit cycles
 // Zero-input behaviour of the bit-accurate cascade (BandpassFixed, its public API): an
