@@ -107,7 +107,9 @@ def main() -> int:
     L.append("")
     L.append("## Limit cycles\n")
     L.append("docs/fixed-point.md claims: after settling the output is bounded by floor(noise_bound/LSB + 1/2) "
-             "and measured at <= 30 LSB (truncate) / 4 LSB (rounding) at the default words. Test: "
+             "(319 LSB at the defaults) and was measured at <= 30 LSB. The test asserts, for every rounding mode "
+             "and excitation at the default words, the bound, <= 4 LSB for rounding to nearest and <= 30 LSB "
+             "for truncation: "
              "`StabilityLimitCycles.TheDocumentedBoundsHoldForEveryModeAndExcitation`. Measured at the "
              "configuration's words (excitation %d samples, then zeros until twice the float decay to LSB/2 "
              "+ 2000, then a 4096-sample window):\n" % 2000)

@@ -340,7 +340,9 @@ TEST(StabilityStructures, TheReceiverRefusesTheDirectStructure) {
 
 // ------------------------------------------------------------------ limit cycles
 // docs/fixed-point.md: after settling the output is bounded by floor(noise_bound/LSB + 1/2)
-// (319 LSB for the defaults) and measured at <= 30 LSB (truncate) / 4 LSB (rounding).
+// (319 LSB for the defaults) and was measured at <= 30 LSB (round-half-up). Here every
+// rounding mode and excitation: the bound holds, rounding to nearest stays within 4 LSB and
+// truncation within 30 LSB.
 TEST(StabilityLimitCycles, TheDocumentedBoundsHoldForEveryModeAndExcitation) {
   const ReceiverConfig cfg;
   BandpassSpec spec = cfg.filter;
