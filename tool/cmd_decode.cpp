@@ -15,6 +15,7 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
+#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 
 namespace ranging::tool {
@@ -35,6 +36,7 @@ int cmd_decode(const Args& args) {
   p.option("--period", "S", "bursts were sent every S seconds, codes 1..eta in turn (default: one burst per code, all at t = 0)");
   p.option("--min-rho", "R", "report bursts whose Pearson rho_max (eq. 9) is at least R, 0..1 (noise triggers score lower)", "0.7");
   p.option("--set", "KEY=VALUE", "override a key of the decoding scene built from the options (repeatable), e.g. receiver.config.detector.threshold=0.5 (docs/scenes.md)");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   p.flag("--json", "machine-readable output");
   if (!p.parse(args)) return 0;
   if (!p.has("--family")) throw InputError("option --family: required (ranging codes --list)");
@@ -74,7 +76,8 @@ int cmd_decode(const Args& args) {
   yaml << "name: decode\nsample_rate: " << fs << "\nmedium:\n  speed_of_sound: " << c
        << "\ntransducers: {}\ngeometry:\n  distances_m: [1.0]\nexcitation:\n  family: " << family << "\n";
   if (p.has("--references")) yaml << "receiver:\n  reference: files\n  references_dir: \"" << *p.get("--references") << "\"\n";
-  Scene scene = parse_scene(yaml.str(), path, ".", parse_overrides(p.values("--set")));
+  Scene scene = parse_scene(yaml.str(), path, ".", parse_overrides(p.values("--set")), p.has("--allow-out-of-spec"));
+  warn_if_out_of_spec("decode", scene.receiver.config);
   const CodeFamily fam = code_family(family);
   const std::size_t burst = static_cast<std::size_t>(fam.length + 3) * static_cast<std::size_t>(scene.receiver.config.chip_samples());
   if (cap.samples.size() < burst) {

@@ -11,6 +11,7 @@
 #include "model/sim/demo.hpp"
 #include "model/base/error.hpp"
 #include "tool/cli.hpp"
+#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 
 namespace ranging::tool {
@@ -48,18 +49,22 @@ int cmd_demo(const Args& args) {
   p.option("--noise-rms", "FS", "white noise rms at the ADC in full-scale units, 0..10", "0.002");
   p.option("--seed", "N", "noise seed", "1");
   p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): correlator_fixed.chip_bits=18, filter.type=ellip (of --config, else of the built-in default)");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   p.flag("--json", "machine-readable output");
   p.flag("--quiet", "no progress on stderr");
   if (!p.parse(args)) return 0;
 
   DemoParams d;
   const Overrides overrides = parse_overrides(p.values("--set"));
+  const bool allow = p.has("--allow-out-of-spec");
   if (auto cfg = p.get("--config"); cfg && p.has("--config")) {
-    d.receiver = load_receiver_config(*cfg, overrides);
+    d.receiver = load_receiver_config(*cfg, overrides, allow);
   } else {
     d.receiver = default_receiver_config(overrides);
   }
+  d.receiver.allow_out_of_spec = allow;
   if (p.has("--family") || !p.has("--config")) d.receiver.family = p.get_or("--family", "Gold4");
+  warn_if_out_of_spec("demo", d.receiver);
   d.distances_m = parse_list("--distances", p.get_or("--distances", ""));
   d.speed_of_sound = p.number("--speed-of-sound", 340, 100, 10000);
   d.gain = p.number("--gain", 0.5, 1e-6, 10);

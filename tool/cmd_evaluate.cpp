@@ -18,6 +18,7 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
+#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/scene_run.hpp"
 
@@ -62,10 +63,12 @@ int cmd_evaluate(const Args& args) {
   p.flag("--json", "print the tables as JSON on stdout");
   p.option("--set", "KEY=VALUE", "override a key of the scene, a dotted YAML path (repeatable): noise.noise_v=0.01; receiver.config.KEY sets a key of its receiver configuration, e.g. receiver.config.correlator_fixed.chip_bits=18");
   p.flag("--quiet", "no progress bar");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
   const std::string scene_path = p.positionals().at(0);
   const Overrides overrides = parse_overrides(p.values("--set"));
-  Scene scene = load_scene(scene_path, overrides);
+  Scene scene = load_scene(scene_path, overrides, p.has("--allow-out-of-spec"));
+  warn_if_out_of_spec("evaluate", scene.receiver.config);
   const std::string out = p.get_or("--out", "docs/results");
   namespace fs = std::filesystem;
   std::error_code ec;

@@ -1,7 +1,14 @@
 // `ranging filter`: design the bandpass filter (default: the paper's spec, Butterworth) and
-// print its second-order sections, pole radii, edge attenuations and quantized coefficients.
+// print its second-order sections, pole radii, edge attenuations and quantized coefficients,
+// and the guard's verdict on the quantized design (model/dsp/stability.hpp): its exact pole
+// radii and attenuations beside the float design's; exit 2 if it is unstable or out of spec
+// unless --allow-out-of-spec. --plot draws |H(f)| float vs quantized over the spec mask
+// (scripts/plot_filter_response.py; the numbers are computed here).
 #include <cstdint>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -12,8 +19,10 @@
 #include "model/base/error.hpp"
 #include "model/dsp/filter_design.hpp"
 #include "model/dsp/quantize.hpp"
+#include "model/dsp/stability.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/guard.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -45,6 +54,54 @@ std::string g17(double v) {
   throw InputError("option " + options + ": " + msg.substr(colon + 2));
 }
 
+std::string joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& f : v) s += (s.empty() ? "" : "; ") + f;
+  return s;
+}
+
+// |H(f)| of the float and the quantized design on a grid, written as JSON for the plot
+// script; the PNG appears under its name only when the script succeeded.
+void plot_response(const std::string& png, const SosFilter& filter, const SosFilter& quantized,
+                   const BandpassSpec& spec, int bits, int frac) {
+  namespace fs = std::filesystem;
+  nlohmann::ordered_json j;
+  const double fmax = std::min(spec.fs / 2, 2 * spec.fs2);
+  std::vector<double> f, af, aq;
+  constexpr int kPoints = 2001;
+  for (int i = 0; i < kPoints; ++i) {
+    const double fr = fmax * i / (kPoints - 1);
+    f.push_back(fr);
+    af.push_back(20 * std::log10(std::max(std::abs(sos_response(filter, fr)), 1e-12)));
+    aq.push_back(20 * std::log10(std::max(std::abs(sos_response(quantized, fr)), 1e-12)));
+  }
+  j["f"] = f;
+  j["float_db"] = af;
+  j["quantized_db"] = aq;
+  j["spec"] = {{"fp1", spec.fp1}, {"fp2", spec.fp2}, {"fs1", spec.fs1}, {"fs2", spec.fs2},
+               {"rp_db", spec.rp_db}, {"rs_db", spec.rs_db}, {"fs", spec.fs}};
+  j["title"] = filter_type_name(filter.type) + " order " + std::to_string(filter.order) + ", coefficients " +
+               std::to_string(bits) + " bits (" + std::to_string(frac) + " fraction)";
+  const std::string data = png + ".data.json", tmp = png + ".tmp";
+  {
+    std::ofstream out(data);
+    out << j.dump() << "\n";
+    if (!out) throw InputError("option --plot: cannot write '" + data + "'");
+  }
+  std::string script = (fs::path(__FILE__).parent_path().parent_path() / "scripts/plot_filter_response.py").string();
+  if (!fs::exists(script)) script = "scripts/plot_filter_response.py";
+  const std::string cmd = "/usr/bin/python3 '" + script + "' '" + data + "' '" + tmp + "' > /dev/null";
+  const int rc = std::system(cmd.c_str());
+  std::error_code ec;
+  fs::remove(data, ec);
+  if (rc != 0) {
+    fs::remove(tmp, ec);
+    throw InputError("option --plot: '" + cmd + "' failed (matplotlib missing?)");
+  }
+  fs::rename(tmp, png, ec);
+  if (ec) throw InputError("option --plot: cannot write '" + png + "': " + ec.message());
+}
+
 }  // namespace
 
 int cmd_filter(const Args& args) {
@@ -63,6 +120,8 @@ int cmd_filter(const Args& args) {
   p.option("--order", "N", "prototype order, 1..20 (default: the minimum meeting the spec)");
   p.option("--coef-bits", "B", "coefficient word length, 2..32", "16");
   p.option("--coef-frac", "F", "coefficient fraction bits, 0..62 (default: B-2)");
+  p.option("--plot", "FILE.png", "draw |H(f)| of the float and the quantized design over the spec mask");
+  p.flag("--allow-out-of-spec", "print a design whose quantized filter is unstable or out of spec (exit 0)");
   p.flag("--json", "machine-readable output");
   if (!p.parse(args)) return 0;
 
@@ -112,6 +171,20 @@ int cmd_filter(const Args& args) {
   double gain = 1;
   for (const Biquad& s : filter.sections) gain *= s.b0;
 
+  // The guard: the quantized integers' exact poles and response against the spec.
+  const DesignGuard guard = check_quantized_design(filter, QuantizedSos{q, frac}, spec, bits);
+  if (!guard.ok() && !p.has("--allow-out-of-spec")) {
+    const std::string hint = " (tolerance " + g17(guard.tolerance_db) + " dB; --allow-out-of-spec prints it anyway)";
+    if (!guard.float_within_spec) {
+      throw InputError("option --order: " + (p.has("--order") ? *p.get("--order") : std::string("minimum")) +
+                       ": the unquantized design misses the spec: " + joined(guard.float_failures) + hint);
+    }
+    throw InputError("option --coef-bits: " + std::to_string(bits) + " (--coef-frac " + std::to_string(frac) +
+                     "): " + joined(guard.failures) + hint);
+  }
+  const SosFilter quantized = quantized_sos_filter(QuantizedSos{q, frac}, filter);
+  if (auto png = p.get("--plot"); png && p.has("--plot")) plot_response(*png, filter, quantized, spec, bits, frac);
+
   if (p.has("--json")) {
     nlohmann::ordered_json j;
     j["type"] = filter_type_name(type);
@@ -132,8 +205,11 @@ int cmd_filter(const Args& args) {
     j["pole_radius"] = radius;
     j["natural_frequencies"] = wn;
     j["gain"] = gain;
+    nlohmann::ordered_json qradius = nlohmann::ordered_json::array();
+    for (const SectionPoles& sp : guard.quantized_poles) qradius.push_back(static_cast<double>(sp.radius));
     j["quantized"] = {{"bits", bits}, {"frac", frac}, {"columns", {"b0", "b1", "b2", "a1", "a2"}},
-                      {"sections", q}};
+                      {"sections", q}, {"pole_radius", qradius}};
+    j["guard"] = guard_json(guard, filter.order);
     std::cout << j.dump() << "\n";
     return 0;
   }
@@ -154,15 +230,39 @@ int cmd_filter(const Args& args) {
        << "\n";
   }
   os << "overall gain (product of b0): " << g17(gain) << "\n\n";
-  os << "attenuation at the spec edges:\n";
+  os << "pole radius per section, float design vs quantized (" << bits << "-bit, " << frac
+     << " fraction bits; exact roots of the integer quadratic):\n";
+  for (size_t k = 0; k < filter.sections.size(); ++k) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "  %zu: %.9f  %.9f%s\n", k + 1, guard.float_radius[k],
+                  static_cast<double>(guard.quantized_poles[k].radius),
+                  guard.quantized_poles[k].stable ? "" : "  UNSTABLE (>= 1)");
+    os << buf;
+  }
+  os << "\nattenuation at the spec edges, float vs quantized:\n";
   const std::pair<const char*, double> edges[] = {
       {"fs1", spec.fs1}, {"fp1", spec.fp1}, {"fp2", spec.fp2}, {"fs2", spec.fs2}};
   for (const auto& [name, f] : edges) {
     char buf[96];
-    std::snprintf(buf, sizeof buf, "  %s %12.1f Hz  %10.4f dB\n", name, f,
-                  attenuation_db(filter, f));
+    std::snprintf(buf, sizeof buf, "  %s %12.1f Hz  %10.4f dB  %10.4f dB\n", name, f,
+                  attenuation_db(filter, f), attenuation_db(quantized, f));
     os << buf;
   }
+  {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "  worst in the passband: %.4f dB (%.0f Hz) vs %.4f dB (%.0f Hz), spec <= %g dB\n"
+                  "  worst in the stopbands: %.4f dB (%.0f Hz) vs %.4f dB (%.0f Hz), spec >= %g dB\n",
+                  guard.passband.float_db, guard.passband.float_f, guard.passband.quantized_db,
+                  guard.passband.quantized_f, spec.rp_db, guard.stopband.float_db, guard.stopband.float_f,
+                  guard.stopband.quantized_db, guard.stopband.quantized_f, spec.rs_db);
+    os << buf;
+  }
+  os << "quantized design: "
+     << (guard.ok() ? std::string("stable and within spec")
+                    : "REFUSED without --allow-out-of-spec: " +
+                          joined(guard.float_within_spec ? guard.failures : guard.float_failures))
+     << " (tolerance " << g17(guard.tolerance_db) << " dB)\n";
   os << "\nquantized coefficients (" << bits << "-bit signed, " << frac
      << " fraction bits, round to nearest): b0 b1 b2 a1 a2\n";
   for (size_t k = 0; k < q.size(); ++k) {

@@ -6,6 +6,7 @@
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
 #include "tool/cli.hpp"
+#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 
 namespace ranging::tool {
@@ -19,13 +20,15 @@ int cmd_generate(const Args& args) {
   p.option("--out", "DIR", "output folder");
   p.option("--origin", "NAME", "name of the configuration in the generated banners (default: FILE as given)");
   p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): correlator_fixed.chip_bits=18, filter.type=ellip; the effective configuration is written as DIR/config.yaml");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
   const auto config = p.get("--config");
   const auto out = p.get("--out");
   if (!config) throw InputError("option --config is required");
   if (!out) throw InputError("option --out is required");
   const Overrides overrides = parse_overrides(p.values("--set"));
-  const ReceiverConfig cfg = load_receiver_config(*config, overrides);
+  const ReceiverConfig cfg = load_receiver_config(*config, overrides, p.has("--allow-out-of-spec"));
+  warn_if_out_of_spec("generate", cfg);
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);
   auto files = generate_hardware_files(design, p.get_or("--origin", *config));

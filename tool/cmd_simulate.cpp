@@ -17,6 +17,7 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
+#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/rotor_run.hpp"
 #include "tool/scene_run.hpp"
@@ -159,8 +160,10 @@ int cmd_simulate(const Args& args) {
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
   p.option("--set", "KEY=VALUE", "override a key of the scene, a dotted YAML path (repeatable): noise.noise_v=0.01; receiver.config.KEY sets a key of its receiver configuration, e.g. receiver.config.correlator_fixed.chip_bits=18");
   p.flag("--quiet", "no progress bar");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
-  Scene scene = load_scene(p.positionals().at(0), parse_overrides(p.values("--set")));
+  Scene scene = load_scene(p.positionals().at(0), parse_overrides(p.values("--set")), p.has("--allow-out-of-spec"));
+  warn_if_out_of_spec("simulate", scene.receiver.config);
   if (p.has("--precision")) {
     const std::string prec = *p.get("--precision");
     if (prec != "float" && prec != "fixed") {
@@ -195,7 +198,9 @@ int cmd_simulate(const Args& args) {
     fs::remove_all(staging, ec);
     throw;
   }
-  const nlohmann::json summary = summary_json(sim, run);
+  nlohmann::json summary = summary_json(sim, run);
+  // The guard's verdict on the receiver's quantized filter (refused at load unless allowed).
+  summary["design_guard"] = guard_json(check_quantized_design(scene.receiver.config), scene.receiver.config.filter_order);
   write_file_atomic(out + "/measurements.csv", measurements_csv(run, scene.speed()));
   write_file_atomic(out + "/summary.json", summary.dump(2) + "\n");
   write_effective_scene(scene, out);  // DIR/scene.yaml (+ config.yaml): re-run with `simulate DIR/scene.yaml`

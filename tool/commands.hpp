@@ -18,5 +18,6 @@ int cmd_decode(const Args& args);    // decode a real capture (cmd_decode.cpp)
 int cmd_doppler(const Args& args);   // decode rate and ToF bias vs line-of-sight speed (cmd_doppler.cpp)
 int cmd_sweep(const Args& args);     // design-space sweep and merge (cmd_sweep.cpp)
 int cmd_wordlength(const Args& args);  // word-length optimization (cmd_wordlength.cpp)
+int cmd_stability(const Args& args); // numerical stability report (cmd_stability.cpp)
 
 }  // namespace ranging::tool

@@ -33,6 +33,8 @@ constexpr Subcommand kSubcommands[] = {
     {"doppler", "decode rate and ToF bias against a constant line-of-sight speed", ranging::tool::cmd_doppler},
     {"sweep", "design-space sweep: accuracy and cost over axes, Pareto fronts (docs/design-space.md)", ranging::tool::cmd_sweep},
     {"wordlength", "smallest fixed-point widths within an accuracy tolerance (docs/design-space.md)", ranging::tool::cmd_wordlength},
+    {"stability", "numerical stability report: guard, headroom, limit cycles, filter structures",
+     ranging::tool::cmd_stability},
 };
 
 void print_usage(std::ostream& os) {

@@ -37,8 +37,9 @@ Overflow parse_overflow(Reader& r, const std::string& k, const std::string& s) {
 
 namespace {
 
-ReceiverConfig parse_document(YAML::Node root, const std::string& origin) {
+ReceiverConfig parse_document(YAML::Node root, const std::string& origin, bool allow_out_of_spec) {
   ReceiverConfig cfg;
+  cfg.allow_out_of_spec = allow_out_of_spec;
   if (!root || root.IsNull()) throw InputError(origin + ": the configuration is empty");
   Reader top(root, origin, "");
   top.get("name", cfg.name);
@@ -53,6 +54,7 @@ ReceiverConfig parse_document(YAML::Node root, const std::string& origin) {
   section(top, "filter", [&](Reader& r) {
     r.get("type", type);
     r.get("order", cfg.filter_order);
+    r.get("structure", cfg.filter_structure);
     r.get("fp1", cfg.filter.fp1);
     r.get("fp2", cfg.filter.fp2);
     r.get("fs1", cfg.filter.fs1);
@@ -122,10 +124,10 @@ ReceiverConfig parse_document(YAML::Node root, const std::string& origin) {
 }  // namespace
 
 ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin,
-                                     const Overrides& overrides) {
+                                     const Overrides& overrides, bool allow_out_of_spec) {
   YAML::Node root = yaml::load(yaml_text, origin);
   apply_overrides(root, overrides, origin);
-  return with_override_errors(overrides, origin, [&] { return parse_document(root, origin); });
+  return with_override_errors(overrides, origin, [&] { return parse_document(root, origin, allow_out_of_spec); });
 }
 
 ReceiverConfig default_receiver_config(const Overrides& overrides) {
@@ -133,12 +135,12 @@ ReceiverConfig default_receiver_config(const Overrides& overrides) {
   return parse_receiver_config("", "(built-in default configuration)", overrides);
 }
 
-ReceiverConfig load_receiver_config(const std::string& path, const Overrides& overrides) {
+ReceiverConfig load_receiver_config(const std::string& path, const Overrides& overrides, bool allow_out_of_spec) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the configuration file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_receiver_config(ss.str(), path, overrides);
+  return parse_receiver_config(ss.str(), path, overrides, allow_out_of_spec);
 }
 
 std::string receiver_config_yaml(const ReceiverConfig& c) {

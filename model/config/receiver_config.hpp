@@ -12,10 +12,13 @@ namespace ranging {
 // YAML (docs/configuration.md). Unknown keys, wrong types and out-of-range values are
 // errors naming the file, line and key.
 // overrides (--set KEY=VALUE, model/config/overrides.hpp) are applied to the document before
-// it is parsed; their errors name the override.
-ReceiverConfig load_receiver_config(const std::string& path, const Overrides& overrides = {});
+// it is parsed; their errors name the override. allow_out_of_spec is carried in the returned
+// config: design_receiver refuses a quantized filter that is unstable or out of spec
+// (model/dsp/stability.hpp) unless it is set.
+ReceiverConfig load_receiver_config(const std::string& path, const Overrides& overrides = {},
+                                    bool allow_out_of_spec = false);
 ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::string& origin,
-                                     const Overrides& overrides = {});
+                                     const Overrides& overrides = {}, bool allow_out_of_spec = false);
 // An empty document with overrides: the built-in default configuration, overridden.
 ReceiverConfig default_receiver_config(const Overrides& overrides);
 std::string receiver_config_yaml(const ReceiverConfig& cfg);

@@ -12,6 +12,7 @@
 
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
+#include "model/dsp/stability.hpp"
 
 namespace ranging {
 
@@ -70,6 +71,13 @@ void validate(const ReceiverConfig& cfg) {
                      "' is not implemented by the fixed-point model; valid: baseband");
   }
   require_in_range("filter.order", cfg.filter_order, 0, 20);
+  if (cfg.filter_structure == "direct") {
+    throw InputError("filter.structure: 'direct' is a study structure (ranging stability, docs/results/stability.md: "
+                     "it needs ~39-bit coefficients for this spec); the receiver and the hardware implement 'sos'");
+  }
+  if (cfg.filter_structure != "sos") {
+    throw InputError("filter.structure: '" + cfg.filter_structure + "' is not valid; valid: sos, direct");
+  }
   validate(cfg.filter);
   if (cfg.filter.fs != cfg.fs) {
     throw InputError("filter.fs must equal signal.fs");
@@ -121,6 +129,8 @@ ReceiverDesign design_receiver(const ReceiverConfig& cfg_in) {
                                   : design_bandpass(cfg.filter, cfg.filter_type);
   // Constructing the fixed filter validates its word lengths against the coefficients.
   BandpassFixed check(d.filter, cfg.bandpass);
+  // The guard on what the integer coefficients implement (unstable / out of spec: refused).
+  enforce_quantized_design(check_quantized_design(d), cfg);
 
   CorrelatorReference& ref = d.reference;
   ref.period = cfg.period();

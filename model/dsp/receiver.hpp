@@ -28,6 +28,9 @@ struct ReceiverConfig {
   BandpassSpec filter;                   // the paper's 150-250 kHz spec by default
   FilterType filter_type = FilterType::Butterworth;
   int filter_order = 0;                  // 0: the minimum order for the spec
+  // "sos" (the cascade the receiver and the hardware implement) or "direct" (one high-order
+  // recursion of the same design: a study structure, ranging stability; refused here).
+  std::string filter_structure = "sos";
   // Matched-filter reference (docs/architecture.md): "received" matches the response of the
   // transducers and the bandpass filter to one chip, as the paper's received templates do;
   // "ideal" matches the bare BPSK excitation.
@@ -42,6 +45,10 @@ struct ReceiverConfig {
   // hardware.clock_hz: the system clock the generated RTL is scheduled for (the iCEBreaker's
   // PLL makes it from 12 MHz); clock_hz / fs clocks per input sample, an integer.
   double clock_hz = 30e6;
+  // Study option, never read from or written to YAML: design_receiver refuses a design whose
+  // quantized filter is unstable or out of spec (model/dsp/stability.hpp) unless it is set
+  // (the tools' --allow-out-of-spec).
+  bool allow_out_of_spec = false;
 
   int period() const;        // fs / f, samples per carrier cycle (validated integer)
   int chip_samples() const;  // q fs / f

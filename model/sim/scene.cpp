@@ -13,6 +13,7 @@
 #include "model/sim/capture.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
+#include "model/dsp/stability.hpp"
 #include "model/config/yaml_reader.hpp"
 
 namespace ranging {
@@ -51,7 +52,7 @@ auto config_errors(F&& load) -> decltype(load()) {
 }
 
 Scene parse_document(YAML::Node root, const std::string& origin, const std::string& base_dir,
-                     const Overrides& config_overrides) {
+                     const Overrides& config_overrides, bool allow_out_of_spec) {
   if (!root || root.IsNull()) throw InputError(origin + ": the scene is empty (it needs at least geometry.distances_m)");
   Scene s;
   s.origin = origin;
@@ -197,7 +198,7 @@ Scene parse_document(YAML::Node root, const std::string& origin, const std::stri
     if (r.get("config", cfg)) {
       std::filesystem::path p(cfg);
       if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
-      rc.config = config_errors([&] { return load_receiver_config(p.string(), config_overrides); });
+      rc.config = config_errors([&] { return load_receiver_config(p.string(), config_overrides, allow_out_of_spec); });
       config_loaded = true;
     }
     if (config_loaded) s.effective_config_yaml = receiver_config_yaml(rc.config);
@@ -239,8 +240,10 @@ Scene parse_document(YAML::Node root, const std::string& origin, const std::stri
   rc.reference_transducer.centre_hz = s.transducers.centre_hz;
   rc.reference_transducer.q = s.transducers.q;
   fit_decimation_to_chip(rc);  // also per family in SceneSimulator (q_of)
+  rc.allow_out_of_spec = allow_out_of_spec;
   try {
     validate(rc);
+    enforce_quantized_design(rc);  // the filter at the scene's sample rate
     validate(TransducerParams{s.transducers.centre_hz, s.transducers.q, false}, s.fs);
     ExcitationParams ex{s.excitation.carrier_hz, s.excitation.cycles_per_chip, s.fs, 1.0};
     validate(ex);
@@ -261,22 +264,22 @@ Scene parse_document(YAML::Node root, const std::string& origin, const std::stri
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& origin, const std::string& base_dir,
-                  const Overrides& overrides) {
+                  const Overrides& overrides, bool allow_out_of_spec) {
   YAML::Node root = yaml::load(text, origin);
   const Overrides scene_overrides = overrides_not_under(overrides, "receiver.config");
   const Overrides config_overrides = overrides_under(overrides, "receiver.config");
   apply_overrides(root, scene_overrides, origin);
   return with_override_errors(scene_overrides, origin,
-                              [&] { return parse_document(root, origin, base_dir, config_overrides); });
+                              [&] { return parse_document(root, origin, base_dir, config_overrides, allow_out_of_spec); });
 }
 
-Scene load_scene(const std::string& path, const Overrides& overrides) {
+Scene load_scene(const std::string& path, const Overrides& overrides, bool allow_out_of_spec) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the scene file");
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return parse_scene(ss.str(), path, dir.empty() ? "." : dir, overrides);
+  return parse_scene(ss.str(), path, dir.empty() ? "." : dir, overrides, allow_out_of_spec);
 }
 
 std::string effective_scene_yaml(const Scene& scene, const std::string& config_file) {

@@ -109,10 +109,12 @@ struct Scene {
 // overrides (--set KEY=VALUE, model/config/overrides.hpp) apply to the scene document before it
 // is parsed; keys under "receiver.config." apply to the receiver configuration the scene
 // references (or to the built-in one), e.g. receiver.config.correlator_fixed.chip_bits=18.
-Scene load_scene(const std::string& path, const Overrides& overrides = {});
+// allow_out_of_spec: accept a receiver whose quantized filter is unstable or out of spec
+// (model/dsp/stability.hpp; refused otherwise, naming the file).
+Scene load_scene(const std::string& path, const Overrides& overrides = {}, bool allow_out_of_spec = false);
 // origin names the file in errors; base_dir resolves relative paths (receiver.config, ...).
 Scene parse_scene(const std::string& yaml_text, const std::string& origin, const std::string& base_dir = ".",
-                  const Overrides& overrides = {});
+                  const Overrides& overrides = {}, bool allow_out_of_spec = false);
 // The effective scene as YAML text, its receiver.config naming config_file (when it has one).
 std::string effective_scene_yaml(const Scene& scene, const std::string& config_file = "config.yaml");
 // Writes DIR/<prefix>scene.yaml and, if the scene has a configuration, DIR/<prefix>config.yaml
