@@ -1,6 +1,7 @@
 // `ranging decode CAPTURE --family NAME`: decode a recorded received signal (an oscilloscope
 // CSV export or a WAV file, model/sim/capture.hpp) with the receiver and the paper's Pearson
-// decoder; print every received burst: code j, ToF, distance, rho_max, u.
+// decoder; print every received burst: code j, ToF, distance, rho_max, the Pearson margin
+// rho_max - rho_submax (eq. 12 as the decoder sees it: the code sent is unknown).
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -96,16 +97,16 @@ int cmd_decode(const Args& args) {
     j["detections"] = nlohmann::json::array();
     for (const auto& d : dets) {
       j["detections"].push_back({{"code", d.code}, {"tof_s", d.tof_s}, {"distance_m", d.tof_s * c},
-                                 {"rho", d.rho_max}, {"u", d.u}, {"pearson_code", d.pearson_code},
+                                 {"rho", d.rho_max}, {"pearson_margin", d.pearson_margin}, {"pearson_code", d.pearson_code},
                                  {"receiver_rho2", d.score}});
     }
     std::cout << j.dump(2) << "\n";
   } else {
     std::printf("%s: %zu samples at %.6g MS/s, family %s, c = %.2f m/s\n", path.c_str(), cap.samples.size(),
                 cap.sample_rate / 1e6, family.c_str(), c);
-    std::printf("%5s %12s %12s %8s %8s\n", "code", "tof_us", "distance_mm", "rho_max", "u");
+    std::printf("%5s %12s %12s %8s %8s\n", "code", "tof_us", "distance_mm", "rho_max", "margin");
     for (const auto& d : dets) {
-      std::printf("%5d %12.3f %12.3f %8.4f %8.4f\n", d.code, d.tof_s * 1e6, d.tof_s * c * 1e3, d.rho_max, d.u);
+      std::printf("%5d %12.3f %12.3f %8.4f %8.4f\n", d.code, d.tof_s * 1e6, d.tof_s * c * 1e3, d.rho_max, d.pearson_margin);
     }
     if (dets.empty()) std::printf("no burst detected\n");
   }
