@@ -73,11 +73,21 @@ SceneRun run_scene(SceneSimulator& sim, bool quiet, const std::string& capture_d
       Capture cap;
       cap.sample_rate = c.fs;
       cap.samples = *c.volts;
+      // What decode needs to reproduce the run (model/sim/capture.hpp): CSV header and sidecar.
+      const Scene& sc = sim.scene();
+      cap.meta.scene = sc.name;
+      cap.meta.family = c.family;
+      cap.meta.code_sent = c.code;
+      cap.meta.true_distance_m = c.distance_m;
+      cap.meta.speed_of_sound = sc.speed();
+      cap.meta.sample_rate = c.fs;
+      if (sc.excitation.schedule.mode == "periodic") cap.meta.period_s = sc.excitation.schedule.period_s;
       std::ostringstream name;
       name << capture_dir << "/" << c.family << "_" << std::llround(c.distance_m * 1e3) << "mm_r" << c.repeat;
       if (c.code > 0) name << "_j" << c.code;
       write_file_atomic(name.str() + ".csv", capture_csv(cap));
       write_file_atomic(name.str() + ".wav", capture_wav(cap, WavFormat::Float32));
+      write_file_atomic(name.str() + ".json", capture_meta_json(cap.meta));
     };
     auto rows = sim.run(f, [&] { bar.tick(); },
                         capture_dir.empty() ? std::function<void(const CaptureStream&)>{} : capture, &fa, &ovf);
