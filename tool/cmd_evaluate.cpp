@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -66,6 +67,37 @@ std::string explanations(const Scene& scene, const std::vector<FamilySummary>& s
       worst_f = s.family;
     }
   }
+  // Ranges quoted in the text, from this run.
+  auto span_of = [](const std::vector<double>& v, int prec) {
+    double lo = 1e300, hi = -1e300;
+    for (double x : v) {
+      if (std::isfinite(x)) {
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+      }
+    }
+    return lo <= hi ? f(lo, prec) + "-" + f(hi, prec) : std::string("--");
+  };
+  std::vector<double> u_ratio7, td_us, spread_m, spread_gold;
+  std::string gold_outlier = "--";
+  double gold_outlier_ratio = 1e300;
+  for (const auto& s : sums) {
+    const auto it = paper_values().find(s.family);
+    if (it == paper_values().end()) continue;
+    const double ratio = s.u_min / it->second.u_min;
+    if (code_family(s.family).length == 7) u_ratio7.push_back(ratio);
+    if (std::isfinite(it->second.td_max_us)) td_us.push_back(s.td_max_s * 1e6);
+    (s.family.rfind("Gold", 0) == 0 ? spread_gold : spread_m).push_back(s.u_max_over_min);
+    if (s.family.rfind("Gold", 0) == 0 && ratio < gold_outlier_ratio) {
+      gold_outlier_ratio = ratio;
+      std::size_t worst = 0;
+      for (std::size_t k = 0; k < s.u_per_code.size(); ++k) {
+        if (s.u_per_code[k] < s.u_per_code[worst]) worst = k;
+      }
+      gold_outlier = s.family + " (u_min " + f(s.u_min, 3) + " against " + f(it->second.u_min, 3) + ", code j = " +
+                     std::to_string(worst + 1) + ")";
+    }
+  }
   md << "\n## Why the numbers differ\n\n"
      << "- **Energy level.** One number sets the absolute level: the pitch-catch sensitivity ("
      << scene.sensitivity << " V/V at 0.1 m, `transducers.sensitivity`), chosen so M1's Energy_min at 1 m "
@@ -79,8 +111,8 @@ std::string explanations(const Scene& scene, const std::vector<FamilySummary>& s
         "+-L chips, u by eq. 10) our u_min is of the paper's size, not several times larger as it was at "
         "one fixed alignment: a competing code's reference finds a lag at which it resembles the burst "
         "(an M code is a cyclic shift of its neighbours, so one chip of lag matches L-1 of its L chips), "
-        "and that, not the noise, sets u. Where ours is lower than the paper's (ratios 0.4-0.9 for the 7-bit "
-        "families) the likely cause is the single-resonator transducer model: it smears neighbouring chips "
+        "and that, not the noise, sets u. Where ours is lower than the paper's (ratios "
+     << span_of(u_ratio7, 2) << " for the 7-bit families) the likely cause is the single-resonator transducer model: it smears neighbouring chips "
         "more or less than the real DYA-200-01B pair, and the similarity of two codes' received templates "
         "at a lag depends on exactly that smearing.\n";
   if (have_energy15) {
@@ -101,13 +133,15 @@ std::string explanations(const Scene& scene, const std::vector<FamilySummary>& s
   }
   md << "- **Ordering that disagrees: Gold u ranks.** Within Gold the rank correlation of u_min is "
      << r("u_min (Pearson, eq. 10)", "gold")
-     << ". The outlier is Gold7: one code (j = 6) has a much closer competitor in ours than in the "
-        "paper, and Gold2/Gold3 are lower too. Gold codes of one family differ in how many single-chip "
+     << ". The furthest below the paper is " << gold_outlier
+     << ": its least distinguishable code has a much closer competitor in ours than in the paper. Gold codes of one family differ in how many single-chip "
         "runs they have, so which two codes look alike after the transducers is again set by how the "
         "transducers smear the chips (likely cause: the transducer model, as above). The spread within a "
-        "family agrees (u max/min 1.70-6.40 against the paper's 1.85-5.85).\n"
+        "family agrees (u max/min "
+     << span_of(spread_gold, 2) << " against the paper's 1.85-5.85).\n"
      << "- **u spread within the M families.** The paper's M codes have nearly equal u (max/min "
-        "1.19-1.33); ours spread 1.8-3.7x. The M families' codes are cyclic shifts of one another, so a "
+        "1.19-1.33); ours spread "
+     << span_of(spread_m, 2) << "x. The M families' codes are cyclic shifts of one another, so a "
         "competitor's best lag is one chip away, where the two codes differ only in the chips that wrap "
         "around; which code is least distinguishable then depends on the chips at the burst's ends and "
         "on the ring-down, where the model and the real transducers differ most.\n"
@@ -116,7 +150,8 @@ std::string explanations(const Scene& scene, const std::vector<FamilySummary>& s
      << r("T_d-max", "all")
      << "). T_d moves in steps of about half a carrier period (2.5 us) because the b/10 crossing jumps "
         "between ring-down half-cycle peaks; the paper's per-family spread (176-189 us) is wider than "
-        "ours (180-186 us), as expected from real transducers with more than one mode and from noise on "
+        "ours ("
+     << span_of(td_us, 1) << " us), as expected from real transducers with more than one mode and from noise on "
         "the threshold crossing.\n"
      << "- **v_max** is eta c / L for every family in both (1/(1.5 T_d-max) is larger), so it matches "
         "Table 6 exactly as long as T_d-max stays below 1/(1.5 eta c/L) = "
@@ -182,6 +217,7 @@ int cmd_evaluate(const Args& args) {
     write_file_atomic(stem + "-fig13.csv", w.str());
   }
   write_file_atomic(stem + "-summary.json", summary_json(sim, run).dump(2) + "\n");
+
 
   std::vector<std::string> figures;
   if (!p.has("--no-plots")) {
@@ -398,7 +434,8 @@ int cmd_evaluate(const Args& args) {
        << fig13_family << " code at " << f(dmin * 1e3, 0) << " mm.\n\n";
     md << "![Figure 14](" << figures[1] << ")\n\nFigure 14: u (eq. 10) per code (mean over distances and repeats).\n\n";
     md << "![Figure 15](" << figures[2] << ")\n\nFigure 15: energy per code at "
-       << f(scene.range_l() * 1e3, 0) << " mm (mean over repeats).\n";
+       << f(scene.range_l() * 1e3, 0) << " mm (mean over repeats).\n\n";
+
   }
   md << "\nData: `" << scene.name << "-per-code.csv`, `" << scene.name << "-fig13.csv`, `" << scene.name
      << "-summary.json`.\n";
