@@ -93,6 +93,16 @@ TEST(Evaluate, ReducedPaperSceneReproducesTable6AndTable5AndWritesTheDocument) {
       EXPECT_LE(rank[q]["all"].get<double>(), 1.0);
     }
   }
+  // Eqs. 7-8: rho(d_min) = 1 by definition (a burst against itself); the shape changes with
+  // distance (absorption), so rho(1 m) < 1, and a Pearson coefficient stays in [-1, 1].
+  for (const char* fam : {"M1", "M3", "Gold4"}) {
+    const auto& v = j["rho_d"][fam];
+    ASSERT_EQ(v.size(), 2u) << fam;
+    EXPECT_NEAR(v[0]["rho_d"].get<double>(), 1.0, 1e-12) << fam;
+    EXPECT_LT(v[1]["rho_d"].get<double>(), 1.0 - 1e-6) << fam;
+    EXPECT_GT(v[1]["rho_d"].get<double>(), -1.0) << fam;
+  }
+  EXPECT_TRUE(fs::exists(dir + "/reduced-fig11.png"));
   const std::string md = slurp(dir + "/reduced.md");
   EXPECT_NE(md.find("| u_min (Pearson, eq. 10) | M1 | 0.129 |"), std::string::npos);
   EXPECT_NE(md.find("| quantity | family | paper | ours | ratio | Spearman"), std::string::npos);
@@ -125,7 +135,7 @@ TEST(Evaluate, CommittedDocumentIsGeneratedFromTheCommittedData) {
     EXPECT_GE(f["decode_errors"].get<int>(), f["detector"]["decode_errors"].get<int>());
     EXPECT_EQ(f["measurements"].get<int>(), 100 * f["eta"].get<int>()) << "10 distances x 10 repeats";
   }
-  for (const char* fig : {"fig13", "fig14", "fig15"}) {
+  for (const char* fig : {"fig11", "fig13", "fig14", "fig15"}) {
     EXPECT_TRUE(fs::exists(root + "paper-section4-" + std::string(fig) + ".png")) << fig;
   }
 }
