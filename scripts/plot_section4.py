@@ -2,7 +2,8 @@
 """Figures 13-15 of the paper's Section 4 from the data `ranging evaluate` writes.
 
 usage: plot_section4.py STEM FIG13_FAMILY
-reads STEM-per-code.csv and STEM-fig13.csv, writes STEM-fig13.png, STEM-fig14.png, STEM-fig15.png.
+reads STEM-per-code.csv, STEM-fig13.csv and STEM-rho-d.csv, writes STEM-fig13.png, STEM-fig14.png,
+STEM-fig15.png and STEM-fig11.png (rho(d), eqs. 7-8).
 """
 import csv
 import sys
@@ -68,6 +69,28 @@ def main():
         fig.suptitle(title, fontsize=10)
         fig.tight_layout()
         fig.savefig(out, dpi=110)
+        plt.close(fig)
+
+    # Figure 11 (bandpass curve): rho(d) per family (eqs. 7-8).
+    try:
+        rd = list(csv.DictReader(open(stem + "-rho-d.csv")))
+    except FileNotFoundError:
+        rd = []
+    if rd:
+        fig, ax = plt.subplots(figsize=(6, 3.6))
+        for fam in families:
+            pts = [(float(r["distance_m"]) * 1e3, float(r["rho_d"])) for r in rd if r["family"] == fam]
+            if pts:
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", ms=3, lw=1, label=fam)
+        ax.set_xlabel("distance d (mm)", fontsize=8)
+        ax.set_ylabel("rho(d)", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.legend(fontsize=6, ncol=2)
+        ax.grid(alpha=0.3)
+        fig.suptitle("Figure 11: correlation of the bandpass-filtered received signal with d_min (eqs. 7-8)",
+                     fontsize=9)
+        fig.tight_layout()
+        fig.savefig(stem + "-fig11.png", dpi=110)
         plt.close(fig)
 
     per_code("u_mean", "Figure 14: distinguishability u per code (mean over distances)", "u",

@@ -1,8 +1,14 @@
 // The paper's metrics and system equations (eq. 1, 3, 4, 9, 12; Tables 4-6).
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
 #include <vector>
+
+#include "tests/process.hpp"
 
 #include "model/base/error.hpp"
 #include "model/sim/metrics.hpp"
@@ -143,4 +149,187 @@ TEST(Heron, VerticalDistance) {
   EXPECT_THROW(heron_vertical_distance(1.0, 5.0, 1.0), InputError);
   EXPECT_THROW(heron_vertical_distance(0.0, 1.0, 1.0), InputError);
   EXPECT_THROW(heron_vertical_distance(1.0, 1.0, -1.0), InputError);
+}
+
+// ---- The matched filter (eq. 9 over lags), eq. 10's u, T_d on a stream ----------------------
+
+namespace {
+
+std::vector<double> random_signal(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::vector<double> v(n);
+  for (double& x : v) x = nd(rng);
+  return v;
+}
+
+// x = zeros(k), t, zeros(tail): the template shifted by k samples.
+std::vector<double> shifted(const std::vector<double>& t, std::size_t k, std::size_t tail) {
+  std::vector<double> x(k, 0.0);
+  x.insert(x.end(), t.begin(), t.end());
+  x.resize(x.size() + tail, 0.0);
+  return x;
+}
+
+}  // namespace
+
+TEST(PearsonOverLags, ShiftedTemplateGivesRhoOneAtItsLag) {
+  const auto t = random_signal(64, 1);
+  for (std::size_t k : {0u, 1u, 17u, 40u}) {
+    const auto x = shifted(t, k, 50);
+    const LagRho d = pearson_over_lags(x, t, -10, 200);
+    EXPECT_NEAR(d.rho, 1.0, 1e-12) << k;
+    EXPECT_EQ(d.lag, static_cast<long>(k));
+    PearsonBank bank({t});
+    const auto b = bank.search(x, -10, 200);
+    ASSERT_EQ(b.size(), 1u);
+    EXPECT_NEAR(b[0].rho, 1.0, 1e-12) << k;
+    EXPECT_EQ(b[0].lag, static_cast<long>(k));
+  }
+  // A window that does not reach lag k finds less than 1.
+  const auto x = shifted(t, 40, 50);
+  EXPECT_LT(pearson_over_lags(x, t, 0, 30).rho, 0.9);
+  // Scale and offset do not matter; an inverted copy gives its best positive rho elsewhere.
+  std::vector<double> y = x;
+  for (double& v : y) v = 3.0 * v + 2.0;
+  EXPECT_NEAR(pearson_over_lags(y, t, 0, 80).rho, 1.0, 1e-12);
+  // No lag of the window inside x: refused.
+  EXPECT_THROW(pearson_over_lags(x, t, 200, 300), InputError);
+  PearsonBank bank({t});
+  EXPECT_THROW(bank.search(x, 200, 300), InputError);
+  EXPECT_THROW(PearsonBank({t, std::vector<double>(10, 1.0)}), InputError);
+  EXPECT_THROW(PearsonBank(std::vector<std::vector<double>>{}), InputError);
+}
+
+TEST(PearsonOverLags, FftBankEqualsTheDirectDefinition) {
+  // Random references and a noisy signal with a scaled copy of one of them: the FFT bank's best
+  // rho and lag per reference equal the direct search over the same window.
+  std::vector<std::vector<double>> ts;
+  for (std::uint64_t j = 0; j < 4; ++j) ts.push_back(random_signal(300, 10 + j));
+  auto x = random_signal(1500, 99);
+  for (std::size_t i = 0; i < 300; ++i) x[700 + i] += 4.0 * ts[2][i] + 0.5;
+  PearsonBank bank(ts);
+  for (auto [lo, hi] : {std::pair<long, long>{0, 1200}, {600, 800}, {-50, 100}, {1100, 5000}}) {
+    const auto b = bank.search(x, lo, hi);
+    for (std::size_t j = 0; j < ts.size(); ++j) {
+      const LagRho d = pearson_over_lags(x, ts[j], lo, hi);
+      EXPECT_NEAR(b[j].rho, d.rho, 1e-12) << j << " [" << lo << "," << hi << "]";
+      EXPECT_EQ(b[j].lag, d.lag) << j;
+    }
+  }
+  EXPECT_EQ(bank.search(x, 0, 1200)[2].lag, 700);
+  // Zero variance segments give rho 0 (as pearson()).
+  std::vector<double> flat(1000, 1.0);
+  EXPECT_EQ(bank.search(flat, 0, 600)[0].rho, 0.0);
+}
+
+TEST(PearsonOverLags, AgreesWithNumpyOracle) {
+  std::vector<std::vector<double>> ts;
+  for (std::uint64_t j = 0; j < 3; ++j) ts.push_back(random_signal(120, 20 + j));
+  auto x = random_signal(700, 7);
+  for (std::size_t i = 0; i < 120; ++i) x[333 + i] += 2.0 * ts[1][i];
+  const std::string path = ::testing::TempDir() + "/pearson_oracle_" + std::to_string(::getpid()) + ".json";
+  std::ofstream(path) << nlohmann::json{{"x", x}, {"templates", ts}}.dump();
+  const long lo = 100, hi = 500;
+  const std::string cmd = std::string(RANGING_PYTHON) + " " + RANGING_SOURCE_DIR +
+                          "/tests/oracle/pearson_lags_oracle.py " + path + " " + std::to_string(lo) + " " +
+                          std::to_string(hi);
+  const auto r = ranging::testing_support::run_command(cmd);
+  std::filesystem::remove(path);
+  ASSERT_EQ(r.status, 0) << cmd << "\n" << r.err;  // no numpy is a failure, not a skip
+  const auto j = nlohmann::json::parse(r.out);
+  PearsonBank bank(ts);
+  const auto b = bank.search(x, lo, hi);
+  ASSERT_EQ(j["best"].size(), ts.size());
+  for (std::size_t k = 0; k < ts.size(); ++k) {
+    EXPECT_NEAR(b[k].rho, j["best"][k]["rho"].get<double>(), 1e-12) << k;
+    EXPECT_EQ(b[k].lag, j["best"][k]["lag"].get<long>()) << k;
+  }
+  EXPECT_EQ(b[1].lag, 333);
+}
+
+TEST(UForSent, Eq10DefinitionOnKnownCases) {
+  // Three references: A, an exact copy of A, and B. The signal contains A.
+  const auto A = random_signal(80, 3), B = random_signal(80, 4);
+  PearsonBank bank({A, A, B});
+  const auto x = shifted(A, 25, 40);
+  std::vector<double> rhos;
+  for (const auto& b : bank.search(x, 0, 200)) rhos.push_back(b.rho);
+  // A sent code identical to another code: u = 0 (the decoder cannot tell them apart).
+  EXPECT_NEAR(u_for_sent(rhos, 1), 0.0, 1e-12);
+  EXPECT_NEAR(u_for_sent(rhos, 2), 0.0, 1e-12);
+  // Sent B but A arrived: a misdecode, u = rho_B - rho_A < 0.
+  EXPECT_LT(u_for_sent(rhos, 3), -0.5);
+  EXPECT_NEAR(u_for_sent(rhos, 3), rhos[2] - 1.0, 1e-12);
+  // Hand values: rho(sent) minus the best other, whatever the ranking.
+  const std::vector<double> r = {0.2, 0.9, 0.71, 0.3};
+  EXPECT_NEAR(u_for_sent(r, 2), 0.19, 1e-15);
+  EXPECT_NEAR(u_for_sent(r, 3), -0.19, 1e-15);
+  EXPECT_NEAR(u_for_sent(r, 1), -0.7, 1e-15);
+  // The decoder's margin (eq. 12 without the code sent) is never negative.
+  EXPECT_NEAR(distinguishability(r).u, 0.19, 1e-15);
+  EXPECT_THROW(u_for_sent(r, 0), InputError);
+  EXPECT_THROW(u_for_sent(r, 5), InputError);
+  EXPECT_THROW(u_for_sent(std::vector<double>{0.5}, 1), InputError);
+}
+
+TEST(DurationStream, MeasuresUntilTheSignalEndsAndFlagsClipping) {
+  constexpr double fs = 5e6;
+  // A burst of alternating +-1 over [500, 1000) followed by a slow ring-down 0.999^n that
+  // stays above b/10 for ln(10)/ln(1/0.999) = 2302 samples: far longer than any fixed window.
+  std::vector<double> x(6000, 0.0);
+  for (std::size_t i = 500; i < 1000; ++i) x[i] = (i % 2 ? 1.0 : -1.0);
+  const std::size_t ring = 2301;  // 0.999^2301 > 0.1 > 0.999^2302
+  for (std::size_t n = 0; n < 2400; ++n) x[1000 + n] = ((1000 + n) % 2 ? 1.0 : -1.0) * std::pow(0.999, n);
+  StreamDuration d = duration_td_stream(x, 400, x.size(), 500, 1000, 100, fs);
+  EXPECT_EQ(d.first, 500u);
+  EXPECT_EQ(d.last, 1000u + ring);
+  EXPECT_DOUBLE_EQ(d.seconds, static_cast<double>(ring + 500) / fs);
+  EXPECT_FALSE(d.clipped);
+  EXPECT_FALSE(d.noise_limited);
+  EXPECT_EQ(d.noise_rms, 0.0);
+  // The search ends inside the ring-down: flagged.
+  d = duration_td_stream(x, 400, 2000, 500, 1000, 100, fs);
+  EXPECT_TRUE(d.clipped);
+  EXPECT_EQ(d.last, 1999u);
+  // The search starts inside the burst: flagged.
+  EXPECT_TRUE(duration_td_stream(x, 600, x.size(), 600, 1000, 100, fs).clipped);
+  // Noise at 0.05 rms: the noise floor (4.5 sigma = 0.225) sets the threshold, estimated from
+  // the samples before the burst; the ring-down is measured to where it sinks below it.
+  std::vector<double> y = x;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> nd(0.0, 0.05);
+  std::vector<double> noise(y.size());
+  for (double& v : noise) v = nd(rng);
+  for (std::size_t i = 0; i < y.size(); ++i) y[i] += noise[i];
+  // Put the burst after 2000 samples of noise so the floor is estimated on 2000 samples.
+  std::vector<double> z(2000, 0.0);
+  for (std::size_t i = 0; i < 2000; ++i) z[i] = nd(rng);
+  z.insert(z.end(), y.begin(), y.end());
+  d = duration_td_stream(z, 2400, z.size(), 2500, 3000, 100, fs);
+  EXPECT_TRUE(d.noise_limited);
+  EXPECT_NEAR(d.noise_rms, 0.05, 0.005);
+  EXPECT_NEAR(d.threshold, 4.5 * d.noise_rms, 1e-15);
+  EXPECT_EQ(d.first, 2500u);
+  // 0.999^n = 0.225 at n = 1485: the ring-down alone crosses up to there, ring-down plus noise
+  // later (the last sample above a), and noise alone (after the ring ends at 5400) never.
+  EXPECT_GE(d.last, 3000u + 1485u);
+  EXPECT_LT(d.last, 5400u);
+  EXPECT_FALSE(d.clipped);
+  EXPECT_THROW(duration_td_stream(x, 10, 5, 500, 1000, 100, fs), InputError);
+  EXPECT_THROW(duration_td_stream(std::vector<double>(100, 0.0), 0, 100, 0, 100, 10, fs), InputError);
+}
+
+TEST(Spearman, RanksWithTies) {
+  // Monotone but non-linear: 1; reversed: -1.
+  EXPECT_NEAR(spearman(std::vector<double>{1, 2, 3, 4}, std::vector<double>{1, 8, 27, 1000}), 1.0, 1e-15);
+  EXPECT_NEAR(spearman(std::vector<double>{1, 2, 3, 4}, std::vector<double>{4, 3, 2, 1}), -1.0, 1e-15);
+  // By hand: ranks a = [1,2,3,4,5], b = [2,1,4,3,5]: d^2 sum 4, 1 - 6*4/(5*24) = 0.8.
+  EXPECT_NEAR(spearman(std::vector<double>{10, 20, 30, 40, 50}, std::vector<double>{0.2, 0.1, 0.4, 0.3, 0.5}), 0.8,
+              1e-15);
+  // Ties take the mean rank: a = [1,2,2,3] -> [1,2.5,2.5,4] against [1,2,3,4]: 0.9487 (scipy).
+  EXPECT_NEAR(spearman(std::vector<double>{1, 2, 2, 3}, std::vector<double>{1, 2, 3, 4}), 0.9486832980505138, 1e-12);
+  EXPECT_TRUE(std::isnan(spearman(std::vector<double>{1, 1, 1}, std::vector<double>{1, 2, 3})));
+  EXPECT_THROW(spearman(std::vector<double>{1}, std::vector<double>{1}), InputError);
+  EXPECT_THROW(spearman(std::vector<double>{1, 2}, std::vector<double>{1, 2, 3}), InputError);
 }

@@ -125,7 +125,8 @@ TEST(SceneSimulator, DeterministicForASeedAndTheSeedMatters) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a[i].det.tof_s, b[i].det.tof_s);
-    EXPECT_EQ(a[i].det.u, b[i].det.u);
+    EXPECT_EQ(a[i].det.pearson_margin, b[i].det.pearson_margin);
+    EXPECT_EQ(a[i].u, b[i].u);
     EXPECT_EQ(a[i].det.energy, b[i].det.energy);
     EXPECT_EQ(a[i].det.code, a[i].code_sent);
     EXPECT_LT(std::abs(a[i].error_m), 1e-4);

@@ -1,14 +1,18 @@
 // `ranging decode CAPTURE --family NAME`: decode a recorded received signal (an oscilloscope
 // CSV export or a WAV file, model/sim/capture.hpp) with the receiver and the paper's Pearson
-// decoder; print every received burst: code j, ToF, distance, rho_max, u.
+// decoder; print every received burst: code j, ToF, distance, rho_max, the Pearson margin
+// rho_max - rho_submax (eq. 12 as the decoder sees it: the code sent is unknown).
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "model/sim/capture.hpp"
+#include "model/sim/capture_calibration.hpp"
+#include "model/sim/metrics.hpp"
 #include "model/dsp/codes.hpp"
 #include "model/base/error.hpp"
 #include "model/sim/medium.hpp"
@@ -20,6 +24,16 @@
 
 namespace ranging::tool {
 
+namespace {
+
+// Where a setting came from, for the output.
+struct Setting {
+  double value = 0;
+  std::string source;  // "option --x", "capture metadata (FILE)", "default"
+};
+
+}  // namespace
+
 int cmd_decode(const Args& args) {
   cli::Parser p("ranging decode",
                 "Decode a capture: oscilloscope CSV (header lines, then rows 'time_s,volts') or WAV\n"
@@ -27,93 +41,186 @@ int cmd_decode(const Args& args) {
                 "burst. The receiver (bandpass, correlator bank, peak detector) adapts to the file's\n"
                 "sample rate (it must be an integer multiple of the 200 kHz carrier); its latency and\n"
                 "the Pearson references are simulated with the calibrated transducers (docs/scenes.md)\n"
-                "unless --references gives recorded ones (DIR/<family>-<j>.csv or .wav).");
+                "unless --references gives recorded ones (DIR/<family>-<j>.csv or .wav); --calibrate\n"
+                "corrects the latency with a capture at a known --distance. The Pearson decoder is the\n"
+                "paper's matched filter (each reference's best rho over lags within +-L chips).\n"
+                "Metadata in the capture (CSV header lines or a sidecar STEM.json, as `simulate\n"
+                "--write-captures` writes) supply the family, speed of sound and burst period unless an\n"
+                "option overrides them; the output says which was used.\n"
+                "Exit status: 0 at least one burst passed the --min-rho gate; 1 nothing passed it\n"
+                "(bursts below the gate are still listed, with their rho); 2 bad input.");
   p.positional("CAPTURE", "capture file (.csv or .wav)");
-  p.option("--family", "NAME", "code family the transmitter used (ranging codes --list)");
+  p.option("--family", "NAME", "code family the transmitter used (ranging codes --list); default: the capture's metadata");
   p.option("--references", "DIR", "recorded reference bursts DIR/<family>-<j>.csv|.wav for the Pearson decoder");
-  p.option("--speed-of-sound", "M/S", "speed of sound, 100..10000 (default 340)");
+  p.option("--speed-of-sound", "M/S", "speed of sound, 100..10000 (default: the capture's metadata, else 340)");
   p.option("--temperature", "C", "air temperature -40..60 C: speed of sound at 50 % RH, 101.325 kPa");
-  p.option("--period", "S", "bursts were sent every S seconds, codes 1..eta in turn (default: one burst per code, all at t = 0)");
+  p.option("--period", "S", "bursts were sent every S seconds, codes 1..eta in turn (default: the capture's metadata, else one burst per code, all at t = 0)");
   p.option("--min-rho", "R", "report bursts whose Pearson rho_max (eq. 9) is at least R, 0..1 (noise triggers score lower)", "0.7");
   p.option("--set", "KEY=VALUE", "override a key of the decoding scene built from the options (repeatable), e.g. receiver.config.detector.threshold=0.5 (docs/scenes.md)");
   p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
+  p.option("--calibrate", "FILE", "a capture of the same transducers at the known --distance (one burst per code at t = 0, or a train with its period in its metadata): corrects the receiver latency per code, the mean for codes it lacks");
+  p.option("--distance", "M", "the distance of the --calibrate capture, 0.001..1000 m");
   p.flag("--json", "machine-readable output");
   if (!p.parse(args)) return 0;
-  if (!p.has("--family")) throw InputError("option --family: required (ranging codes --list)");
-  const std::string family = *p.get("--family");
+  const std::string path = p.positionals().at(0);
+  Capture cap = read_capture(path);
+  const CaptureMeta& meta = cap.meta;
+  const std::string meta_src = "capture metadata (" + (meta.source.empty() ? path : meta.source) + ")";
+
+  std::string family, family_source;
+  if (p.has("--family")) {
+    family = *p.get("--family");
+    family_source = "option --family";
+  } else if (meta.family) {
+    family = *meta.family;
+    family_source = meta_src;
+  } else {
+    throw InputError("option --family: required (the capture has no family metadata; ranging codes --list)");
+  }
   try {
     (void)code_family(family);
   } catch (const InputError& e) {
-    throw InputError(std::string("option --family: ") + e.what());
+    throw InputError((p.has("--family") ? std::string("option --family: ") : meta_src + ": family: ") + e.what());
   }
   if (p.has("--speed-of-sound") && p.has("--temperature")) {
     throw InputError("options --speed-of-sound and --temperature: give one, not both");
   }
-  double c = p.number("--speed-of-sound", 340, 100, 10000);
-  if (p.has("--temperature")) {
+  Setting c{340.0, "default (340 m/s, the paper's)"};
+  if (p.has("--speed-of-sound")) {
+    c = {p.number("--speed-of-sound", 340, 100, 10000), "option --speed-of-sound"};
+  } else if (p.has("--temperature")) {
     AirConditions a;
     a.temperature_c = p.number("--temperature", 20, -40, 60);
-    c = speed_of_sound(a);
+    c = {speed_of_sound(a), "option --temperature"};
+  } else if (meta.speed_of_sound) {
+    c = {*meta.speed_of_sound, meta_src};
   }
-  const double period = p.number("--period", 0, 0, 10);
+  Setting period{0.0, "default (one burst per code at t = 0)"};
+  if (p.has("--period")) {
+    period = {p.number("--period", 0, 0, 10), "option --period"};
+  } else if (meta.period_s) {
+    period = {*meta.period_s, meta_src};
+  }
   const double min_rho = p.number("--min-rho", 0.7, 0, 1);
-  const std::string path = p.positionals().at(0);
-  Capture cap = read_capture(path);
+  if (p.has("--calibrate") != p.has("--distance")) {
+    throw InputError("options --calibrate and --distance: give both (a capture and the distance it was taken at)");
+  }
+  const double cal_distance = p.number("--distance", 1.0, 0.001, 1000);
 
   // The receiver needs an integer number of samples per carrier cycle.
   constexpr double carrier = 200e3;
-  const double ratio = cap.sample_rate / carrier;
-  if (std::abs(ratio - std::round(ratio)) > 1e-3 * ratio || std::round(ratio) < 4) {
-    std::ostringstream os;
-    os << path << ": sample rate " << cap.sample_rate << " Hz is " << ratio
-       << " samples per 200 kHz carrier cycle; the receiver needs an integer >= 4 (e.g. 1, 2.5, 5 or 10 MS/s)";
-    throw InputError(os.str());
-  }
-  const double fs = std::round(ratio) * carrier;
+  auto check_rate = [&](const Capture& k, const std::string& file) {
+    const double ratio = k.sample_rate / carrier;
+    if (std::abs(ratio - std::round(ratio)) > 1e-3 * ratio || std::round(ratio) < 4) {
+      std::ostringstream os;
+      os << file << ": sample rate " << k.sample_rate << " Hz is " << ratio
+         << " samples per 200 kHz carrier cycle; the receiver needs an integer >= 4 (e.g. 1, 2.5, 5 or 10 MS/s)";
+      throw InputError(os.str());
+    }
+    return std::round(ratio) * carrier;
+  };
+  const double fs = check_rate(cap, path);
 
   std::ostringstream yaml;
   yaml.precision(17);
-  yaml << "name: decode\nsample_rate: " << fs << "\nmedium:\n  speed_of_sound: " << c
+  yaml << "name: decode\nsample_rate: " << fs << "\nmedium:\n  speed_of_sound: " << c.value
        << "\ntransducers: {}\ngeometry:\n  distances_m: [1.0]\nexcitation:\n  family: " << family << "\n";
   if (p.has("--references")) yaml << "receiver:\n  reference: files\n  references_dir: \"" << *p.get("--references") << "\"\n";
   Scene scene = parse_scene(yaml.str(), path, ".", parse_overrides(p.values("--set")), p.has("--allow-out-of-spec"));
   warn_if_out_of_spec("decode", scene.receiver.config);
   const CodeFamily fam = code_family(family);
   const std::size_t burst = static_cast<std::size_t>(fam.length + 3) * static_cast<std::size_t>(scene.receiver.config.chip_samples());
-  if (cap.samples.size() < burst) {
-    std::ostringstream os;
-    os << path << ": too short: " << cap.samples.size() << " samples (" << cap.samples.size() / fs * 1e6
-       << " us) hold less than one burst of " << family << " (" << burst << " samples, " << burst / fs * 1e6 << " us)";
-    throw InputError(os.str());
-  }
+  auto check_len = [&](const Capture& k, const std::string& file) {
+    if (k.samples.size() < burst) {
+      std::ostringstream os;
+      os << file << ": too short: " << k.samples.size() << " samples (" << k.samples.size() / fs * 1e6
+         << " us) hold less than one burst of " << family << " (" << burst << " samples, " << burst / fs * 1e6 << " us)";
+      throw InputError(os.str());
+    }
+  };
+  check_len(cap, path);
   SceneSimulator sim(scene);
-  std::vector<Detection> dets;
-  for (const auto& d : sim.decode(family, cap.samples, cap.t0, period)) {
-    if (d.rho_max >= min_rho) dets.push_back(d);
+
+  std::optional<LatencyCalibration> cal;
+  if (p.has("--calibrate")) {
+    const std::string cal_path = *p.get("--calibrate");
+    Capture k = read_capture(cal_path);
+    if (std::abs(check_rate(k, cal_path) - fs) > 1e-6 * fs) {
+      throw InputError("option --calibrate: " + cal_path + " is sampled at " + std::to_string(k.sample_rate) +
+                       " Hz, the capture at " + std::to_string(cap.sample_rate) + " Hz");
+    }
+    check_len(k, cal_path);
+    std::vector<Detection> kd;
+    // The calibration capture's own burst period (its metadata) if it has one, else the capture's.
+    const double kperiod = k.meta.period_s ? *k.meta.period_s : period.value;
+    for (const auto& d : sim.decode(family, k.samples, k.t0, kperiod)) {
+      if (d.rho_max >= min_rho) kd.push_back(d);
+    }
+    cal = calibrate_latency(kd, cal_distance, c.value, "option --calibrate (" + cal_path + ")");
   }
+
+  std::vector<Detection> dets, below;
+  for (auto d : sim.decode(family, cap.samples, cap.t0, period.value)) {
+    if (cal) d.tof_s = cal->correct(d.code, d.tof_s);
+    (d.rho_max >= min_rho ? dets : below).push_back(d);
+  }
+  const bool known = meta.code_sent && *meta.code_sent > 0;
+  auto det_json = [&](const Detection& d) {
+    nlohmann::json o = {{"code", d.code}, {"tof_s", d.tof_s}, {"distance_m", d.tof_s * c.value},
+                        {"rho", d.rho_max}, {"pearson_margin", d.pearson_margin}, {"pearson_code", d.pearson_code},
+                        {"receiver_rho2", d.score}};
+    if (known && d.rho.size() >= 2 && *meta.code_sent <= static_cast<int>(d.rho.size())) {
+      o["u"] = u_for_sent(d.rho, *meta.code_sent);  // eq. 10, with the code the metadata says was sent
+    }
+    if (meta.true_distance_m) o["error_m"] = d.tof_s * c.value - *meta.true_distance_m;
+    return o;
+  };
 
   if (p.has("--json")) {
     nlohmann::json j;
     j["sample_rate"] = cap.sample_rate;
     j["family"] = family;
-    j["speed_of_sound"] = c;
-    j["detections"] = nlohmann::json::array();
-    for (const auto& d : dets) {
-      j["detections"].push_back({{"code", d.code}, {"tof_s", d.tof_s}, {"distance_m", d.tof_s * c},
-                                 {"rho", d.rho_max}, {"u", d.u}, {"pearson_code", d.pearson_code},
-                                 {"receiver_rho2", d.score}});
+    j["family_source"] = family_source;
+    j["speed_of_sound"] = c.value;
+    j["speed_of_sound_source"] = c.source;
+    j["period_s"] = period.value;
+    j["period_source"] = period.source;
+    j["min_rho"] = min_rho;
+    if (cal) {
+      nlohmann::json per = nlohmann::json::object();
+      for (const auto& [code, v] : cal->per_code_s) per[std::to_string(code)] = v;
+      j["calibration"] = {{"file", *p.get("--calibrate")}, {"distance_m", cal_distance},
+                          {"latency_correction_s", per}, {"mean_correction_s", cal->mean_s}};
     }
+    if (meta.scene) j["scene"] = *meta.scene;
+    if (meta.code_sent) j["code_sent"] = *meta.code_sent;
+    if (meta.true_distance_m) j["true_distance_m"] = *meta.true_distance_m;
+    j["detections"] = nlohmann::json::array();
+    for (const auto& d : dets) j["detections"].push_back(det_json(d));
+    j["below_gate"] = nlohmann::json::array();
+    for (const auto& d : below) j["below_gate"].push_back(det_json(d));
+    j["found"] = !dets.empty();
     std::cout << j.dump(2) << "\n";
   } else {
-    std::printf("%s: %zu samples at %.6g MS/s, family %s, c = %.2f m/s\n", path.c_str(), cap.samples.size(),
-                cap.sample_rate / 1e6, family.c_str(), c);
-    std::printf("%5s %12s %12s %8s %8s\n", "code", "tof_us", "distance_mm", "rho_max", "u");
+    std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s\n",
+                 family.c_str(), family_source.c_str(), c.value, c.source.c_str(), period.value,
+                 period.source.c_str());
+    std::printf("%s: %zu samples at %.6g MS/s, family %s, c = %.2f m/s%s\n", path.c_str(), cap.samples.size(),
+                cap.sample_rate / 1e6, family.c_str(), c.value, cal ? ", latency calibrated" : "");
+    std::printf("%5s %12s %12s %8s %8s\n", "code", "tof_us", "distance_mm", "rho_max", "margin");
     for (const auto& d : dets) {
-      std::printf("%5d %12.3f %12.3f %8.4f %8.4f\n", d.code, d.tof_s * 1e6, d.tof_s * c * 1e3, d.rho_max, d.u);
+      std::printf("%5d %12.3f %12.3f %8.4f %8.4f\n", d.code, d.tof_s * 1e6, d.tof_s * c.value * 1e3, d.rho_max,
+                  d.pearson_margin);
     }
-    if (dets.empty()) std::printf("no burst detected\n");
+    for (const auto& d : below) {
+      std::printf("%5d %12.3f %12.3f %8.4f %8.4f  below the gate (rho %.4f < --min-rho %.4g)\n", d.code,
+                  d.tof_s * 1e6, d.tof_s * c.value * 1e3, d.rho_max, d.pearson_margin, d.rho_max, min_rho);
+    }
+    if (dets.empty()) {
+      std::printf(below.empty() ? "no burst detected\n" : "no burst passed the gate\n");
+    }
   }
-  return 0;
+  return dets.empty() ? 1 : 0;
 }
 
 }  // namespace ranging::tool

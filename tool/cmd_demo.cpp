@@ -79,17 +79,18 @@ int cmd_demo(const Args& args) {
   });
   if (!quiet) std::fprintf(stderr, "\n");
 
-  int errors_flt = 0, errors_fix = 0;
+  int errors_flt = 0, errors_fix = 0, errors_pearson = 0;
   for (const auto& r : rows) {
     errors_flt += r.flt.decoded != r.code;
     errors_fix += r.fix.decoded != r.code;
+    errors_pearson += r.pearson_decoded != r.code;
   }
   if (json) {
     nlohmann::json out;
     out["family"] = d.receiver.family;
     out["speed_of_sound"] = d.speed_of_sound;
     out["noise_rms"] = d.noise_rms;
-    out["decode_errors"] = {{"float", errors_flt}, {"fixed", errors_fix}};
+    out["decode_errors"] = {{"float", errors_flt}, {"fixed", errors_fix}, {"pearson", errors_pearson}};
     out["rows"] = nlohmann::json::array();
     auto dec = [](const DemoDecode& x) {
       return nlohmann::json{{"detected", x.detected}, {"decoded", x.decoded}, {"tof_s", x.tof_s},
@@ -109,17 +110,19 @@ int cmd_demo(const Args& args) {
                 d.receiver.family.c_str(), d.speed_of_sound, d.noise_rms);
     std::printf("%4s %8s | %5s %10s %9s %8s | %5s %10s %9s %8s | %6s %6s\n", "sent", "true_mm",
                 "f.dec", "f.tof_us", "f.dist_mm", "f.err_mm", "x.dec", "x.tof_us", "x.dist_mm",
-                "x.err_mm", "u", "rho2");
+                "x.err_mm", "u_eq10", "rho2");
     for (const auto& r : rows) {
       std::printf("%4d %8.1f | %5d %10.3f %9.3f %8.3f | %5d %10.3f %9.3f %8.3f | %6.3f %6.3f\n",
                   r.code, r.distance_m * 1e3, r.flt.decoded, r.flt.tof_s * 1e6,
                   r.flt.distance_m * 1e3, r.flt.error_m * 1e3, r.fix.decoded, r.fix.tof_s * 1e6,
                   r.fix.distance_m * 1e3, r.fix.error_m * 1e3, r.u, r.fix.score);
     }
-    std::printf("\ndecode errors: float %d/%zu, fixed %d/%zu\n", errors_flt, rows.size(), errors_fix,
-                rows.size());
+    std::printf("\ndecode errors: float %d/%zu, fixed %d/%zu, Pearson %d/%zu\n", errors_flt, rows.size(), errors_fix,
+                rows.size(), errors_pearson, rows.size());
+    std::printf("(u_eq10: the paper's Pearson matched filter, rho(sent) - max rho(other), < 0 on a misdecode;\n"
+                " rho2: the hardware detector's score)\n");
   }
-  return (errors_flt == 0 && errors_fix == 0) ? 0 : 1;
+  return (errors_flt == 0 && errors_fix == 0 && errors_pearson == 0) ? 0 : 1;
 }
 
 }  // namespace ranging::tool

@@ -75,11 +75,21 @@ SceneRun run_scene(SceneSimulator& sim, bool quiet, const std::string& capture_d
       Capture cap;
       cap.sample_rate = c.fs;
       cap.samples = *c.volts;
+      // What decode needs to reproduce the run (model/sim/capture.hpp): CSV header and sidecar.
+      const Scene& sc = sim.scene();
+      cap.meta.scene = sc.name;
+      cap.meta.family = c.family;
+      cap.meta.code_sent = c.code;
+      cap.meta.true_distance_m = c.distance_m;
+      cap.meta.speed_of_sound = sc.speed();
+      cap.meta.sample_rate = c.fs;
+      if (sc.excitation.schedule.mode == "periodic") cap.meta.period_s = sc.excitation.schedule.period_s;
       std::ostringstream name;
       name << capture_dir << "/" << c.family << "_" << std::llround(c.distance_m * 1e3) << "mm_r" << c.repeat;
       if (c.code > 0) name << "_j" << c.code;
       write_file_atomic(name.str() + ".csv", capture_csv(cap));
       write_file_atomic(name.str() + ".wav", capture_wav(cap, WavFormat::Float32));
+      write_file_atomic(name.str() + ".json", capture_meta_json(cap.meta));
     };
     auto rows = sim.run(f, [&] { bar.tick(); },
                         capture_dir.empty() ? std::function<void(const CaptureStream&)>{} : capture, &fa, &ovf);
@@ -94,14 +104,16 @@ SceneRun run_scene(SceneSimulator& sim, bool quiet, const std::string& capture_d
 std::string measurements_csv(const SceneRun& run, double /*c*/) {
   std::ostringstream os;
   os << "family,repeat,burst,true_distance_m,code_sent,code_decoded,tof_s,distance_m,error_m,"
-        "rho_max,rho_submax,u,energy_v2,td_s,pearson_code,receiver_rho2\n";
+        "rho_max,rho_submax,u,energy_v2,td_s,pearson_code,receiver_rho2,receiver_rho2_margin,pearson_margin,"
+        "td_clipped,td_noise_limited\n";
   for (const auto& r : run.rows) {
     os << r.family << "," << r.repeat << "," << r.burst << "," << num(r.true_distance_m) << "," << r.code_sent
        << "," << (r.detected ? r.det.code : 0) << "," << (r.detected ? num(r.det.tof_s, 12) : "") << ","
        << (r.detected ? num(r.distance_m, 12) : "") << "," << (r.detected ? num(r.error_m, 6) : "") << ","
-       << num(r.det.rho_max, 6) << "," << num(r.det.rho_submax, 6) << "," << num(r.det.u, 6) << ","
+       << num(r.det.rho_max, 6) << "," << num(r.det.rho_submax, 6) << "," << num(r.u, 6) << ","
        << num(r.det.energy, 6) << "," << num(r.det.td_s, 6) << "," << r.det.pearson_code << ","
-       << (r.detected ? num(r.det.score, 6) : "") << "\n";
+       << (r.detected ? num(r.det.score, 6) : "") << "," << (r.detected ? num(r.det.detector_margin, 6) : "") << ","
+       << num(r.det.pearson_margin, 6) << "," << r.det.td_clipped << "," << r.det.td_noise_limited << "\n";
   }
   return os.str();
 }
@@ -124,14 +136,24 @@ nlohmann::json summary_json(const SceneSimulator& sim, const SceneRun& run) {
     nlohmann::json per;
     for (std::size_t k = 0; k < f.u_per_code.size(); ++k) {
       per.push_back({{"code", k + 1}, {"u", jnum(f.u_per_code[k])}, {"energy_v2", jnum(f.energy_per_code[k])},
-                     {"td_s", jnum(f.td_per_code[k])}});
+                     {"td_s", jnum(f.td_per_code[k])},
+                     {"detector_rho2_margin", jnum(f.detector_margin_per_code[k])}});
     }
     j["families"].push_back({{"family", f.family}, {"eta", f.eta}, {"measurements", f.measurements},
                              {"decode_errors", f.decode_errors}, {"decode_error_rate", f.error_rate},
                              {"missed", f.missed}, {"false_alarms", f.false_alarms},
                              {"distance_rmse_m", jnum(f.rmse_m)}, {"u_min", jnum(f.u_min)},
                              {"energy_min_v2", jnum(f.energy_min)}, {"td_max_s", jnum(f.td_max_s)},
-                             {"vmax_hz", jnum(f.vmax_hz)}, {"fixed_overflows", f.overflows}, {"per_code", per}});
+                             {"vmax_hz", jnum(f.vmax_hz)}, {"fixed_overflows", f.overflows},
+                             // decode_errors above is the union of the two decoders' errors.
+                             {"detector", {{"metric", "receiver rho^2 (hardware detector)"},
+                                           {"decode_errors", f.detector_errors},
+                                           {"rho2_margin_min", jnum(f.detector_margin_min)}}},
+                             {"pearson", {{"metric", "paper: Pearson matched filter over +-L chips, u by eq. 10"},
+                                          {"decode_errors", f.pearson_errors}, {"u_min", jnum(f.u_min)},
+                                          {"u_max_over_min", jnum(f.u_max_over_min)}}},
+                             {"td_clipped", f.td_clipped}, {"td_noise_limited", f.td_noise_limited},
+                             {"per_code", per}});
   }
   j["decode_errors"] = err;
   j["measurements"] = n;
@@ -212,12 +234,19 @@ int cmd_simulate(const Args& args) {
   if (json) {
     std::cout << summary.dump(2) << "\n";
   } else {
-    std::printf("\n%-8s %4s %6s %7s %10s %8s %11s %9s %9s\n", "family", "eta", "n", "errors", "rmse_mm", "u_min",
-                "energy_min", "Td_max_us", "vmax_Hz");
+    std::printf("\n%-8s %4s %6s %7s %7s %7s %10s %10s %9s %11s %9s %9s %7s %8s\n", "family", "eta", "n", "errors",
+                "det.err", "prs.err", "rmse_mm", "rho2_mrg", "u_min", "energy_min", "Td_max_us", "vmax_Hz", "Td_clip",
+                "Td_noise");
     for (const auto& f : run.summaries) {
-      std::printf("%-8s %4d %6zu %7zu %10.4f %8.4f %11.4g %9.1f %9.0f\n", f.family.c_str(), f.eta, f.measurements,
-                  f.decode_errors, f.rmse_m * 1e3, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz);
+      std::printf("%-8s %4d %6zu %7zu %7zu %7zu %10.4f %10.4f %9.4f %11.4g %9.1f %9.0f %7zu %8zu\n", f.family.c_str(),
+                  f.eta, f.measurements, f.decode_errors, f.detector_errors, f.pearson_errors, f.rmse_m * 1e3,
+                  f.detector_margin_min, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz, f.td_clipped,
+                  f.td_noise_limited);
     }
+    std::printf("errors = missed or misdecoded by either decoder; det.err / rho2_mrg: the receiver's (hardware)\n"
+                "rho^2 detector and its smallest per-code mean margin; prs.err / u_min: the paper's Pearson\n"
+                "matched filter (+-L chips) and eq. 10's u; Td_clip / Td_noise: T_d measurements the search\n"
+                "range clipped / whose threshold the noise floor set (docs/signal-model.md)\n");
     std::printf("\nwrote %s/measurements.csv, %s/summary.json, %s/scene.yaml%s\n", out.c_str(), out.c_str(), out.c_str(),
                 p.has("--write-captures") ? (", " + out + "/captures/").c_str() : "");
   }

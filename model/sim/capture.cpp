@@ -7,7 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "model/base/error.hpp"
 
@@ -46,7 +49,98 @@ std::vector<std::string> split_cells(const std::string& line) {
 
 }  // namespace
 
+namespace {
+
+void check_meta(const CaptureMeta& m, const std::function<std::string(const char*)>& where) {
+  if (m.code_sent && (*m.code_sent < 0 || *m.code_sent > 1000)) {
+    throw InputError(where("code_sent") + ": " + std::to_string(*m.code_sent) + " is out of range; valid 0..1000");
+  }
+  auto range = [&](const char* key, const std::optional<double>& v, double lo, double hi) {
+    if (v && !(std::isfinite(*v) && *v > lo && *v <= hi)) {
+      std::ostringstream os;
+      os << where(key) << ": " << *v << " is out of range; valid (" << lo << ", " << hi << "]";
+      throw InputError(os.str());
+    }
+  };
+  range("true_distance_m", m.true_distance_m, 0, 1000);
+  range("speed_of_sound", m.speed_of_sound, 100, 10000);
+  range("sample_rate", m.sample_rate, 0, 1e12);
+  range("period_s", m.period_s, 0, 10);
+}
+
+void read_meta_line(CaptureMeta& m, const std::string& key, const std::string& value, const std::string& origin,
+                    std::size_t line) {
+  auto number = [&]() {
+    double x = 0;
+    if (!parse_number(value, x)) fail_at(origin, line, key + ": '" + value + "' is not a number");
+    return x;
+  };
+  if (key == "Scene") m.scene = value;
+  else if (key == "Family") m.family = value;
+  else if (key == "Code Sent") {
+    const double x = number();
+    if (x != std::floor(x)) fail_at(origin, line, key + ": '" + value + "' is not an integer");
+    m.code_sent = static_cast<int>(std::clamp(x, -1.0, 1e6));
+  } else if (key == "True Distance (m)") m.true_distance_m = number();
+  else if (key == "Speed of Sound (m/s)") m.speed_of_sound = number();
+  else if (key == "Sample Rate (Hz)") m.sample_rate = number();
+  else if (key == "Burst Period (s)") m.period_s = number();
+  else return;
+  check_meta(m, [&](const char*) { return origin + ":" + std::to_string(line) + ": " + key; });
+}
+
+}  // namespace
+
+std::string capture_meta_json(const CaptureMeta& m) {
+  nlohmann::json j = nlohmann::json::object();
+  if (m.scene) j["scene"] = *m.scene;
+  if (m.family) j["family"] = *m.family;
+  if (m.code_sent) j["code_sent"] = *m.code_sent;
+  if (m.true_distance_m) j["true_distance_m"] = *m.true_distance_m;
+  if (m.speed_of_sound) j["speed_of_sound"] = *m.speed_of_sound;
+  if (m.sample_rate) j["sample_rate"] = *m.sample_rate;
+  if (m.period_s) j["period_s"] = *m.period_s;
+  return j.dump(2) + "\n";
+}
+
+CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& origin) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(origin + ": not valid JSON: " + e.what());
+  }
+  if (!j.is_object()) throw InputError(origin + ": expected a JSON object of capture metadata");
+  CaptureMeta m;
+  for (const auto& [key, v] : j.items()) {
+    auto num = [&]() {
+      if (!v.is_number()) throw InputError(origin + ": key " + key + ": expected a number");
+      return v.get<double>();
+    };
+    auto str = [&]() {
+      if (!v.is_string()) throw InputError(origin + ": key " + key + ": expected a string");
+      return v.get<std::string>();
+    };
+    if (key == "scene") m.scene = str();
+    else if (key == "family") m.family = str();
+    else if (key == "code_sent") {
+      if (!v.is_number_integer()) throw InputError(origin + ": key code_sent: expected an integer 0..1000");
+      m.code_sent = static_cast<int>(std::clamp<long long>(v.get<long long>(), -1, 1000000));
+    } else if (key == "true_distance_m") m.true_distance_m = num();
+    else if (key == "speed_of_sound") m.speed_of_sound = num();
+    else if (key == "sample_rate") m.sample_rate = num();
+    else if (key == "period_s") m.period_s = num();
+    else {
+      throw InputError(origin + ": unknown key '" + key +
+                       "'; valid: scene, family, code_sent, true_distance_m, speed_of_sound, sample_rate, period_s");
+    }
+  }
+  check_meta(m, [&](const char* key) { return origin + ": key " + key; });
+  return m;
+}
+
 Capture parse_capture_csv(const std::string& text, const std::string& origin) {
+  Capture c;
   std::vector<double> t, v;
   std::vector<std::size_t> lines;
   std::stringstream in(text);
@@ -62,7 +156,10 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
     const auto cells = split_cells(line);
     double first = 0;
     const bool numeric_first = !cells.empty() && parse_number(cells[0], first);
-    if (!data && !numeric_first) continue;  // header line (before the first data row)
+    if (!data && !numeric_first) {  // header line (before the first data row); metadata keys
+      if (cells.size() >= 2) read_meta_line(c.meta, cells[0], cells[1], origin, lineno);
+      continue;
+    }
     data = true;
     if (cells.size() < 2) fail_at(origin, lineno, "expected 'time,voltage', found one column");
     double val[2];
@@ -98,9 +195,9 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
       fail_at(origin, lines[n], os.str());
     }
   }
-  Capture c;
   c.sample_rate = 1.0 / dt;
   c.t0 = t.front();
+  if (!c.meta.empty()) c.meta.source = "csv header";
   c.samples = std::move(v);
   return c;
 }
@@ -208,14 +305,42 @@ Capture read_capture(const std::string& path) {
   if (!in) throw InputError(path + ": cannot open the capture file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return ext == "csv" ? parse_capture_csv(ss.str(), path) : parse_capture_wav(ss.str(), path);
+  Capture c = ext == "csv" ? parse_capture_csv(ss.str(), path) : parse_capture_wav(ss.str(), path);
+  const std::string sidecar = path.substr(0, path.size() - 4) + ".json";
+  std::ifstream js(sidecar, std::ios::binary);
+  if (js) {
+    std::stringstream sj;
+    sj << js.rdbuf();
+    const CaptureMeta m = parse_capture_meta_json(sj.str(), sidecar);
+    CaptureMeta& o = c.meta;
+    const bool had = !o.empty();
+    if (!o.scene) o.scene = m.scene;
+    if (!o.family) o.family = m.family;
+    if (!o.code_sent) o.code_sent = m.code_sent;
+    if (!o.true_distance_m) o.true_distance_m = m.true_distance_m;
+    if (!o.speed_of_sound) o.speed_of_sound = m.speed_of_sound;
+    if (!o.sample_rate) o.sample_rate = m.sample_rate;
+    if (!o.period_s) o.period_s = m.period_s;
+    if (!m.empty()) o.source = had ? o.source + " and " + sidecar : sidecar;
+  }
+  return c;
 }
 
 std::string capture_csv(const Capture& c) {
   std::ostringstream os;
   os.precision(9);
   os << "Model,ranging simulate\nRecord Length," << c.samples.size() << "\nSample Interval,"
-     << 1.0 / c.sample_rate << "\nTIME,CH1\n";
+     << 1.0 / c.sample_rate << "\n";
+  const CaptureMeta& m = c.meta;
+  os.precision(12);
+  if (m.scene) os << "Scene," << *m.scene << "\n";
+  if (m.family) os << "Family," << *m.family << "\n";
+  if (m.code_sent) os << "Code Sent," << *m.code_sent << "\n";
+  if (m.true_distance_m) os << "True Distance (m)," << *m.true_distance_m << "\n";
+  if (m.speed_of_sound) os << "Speed of Sound (m/s)," << *m.speed_of_sound << "\n";
+  if (m.sample_rate) os << "Sample Rate (Hz)," << *m.sample_rate << "\n";
+  if (m.period_s) os << "Burst Period (s)," << *m.period_s << "\n";
+  os << "TIME,CH1\n";
   char buf[64];
   for (std::size_t n = 0; n < c.samples.size(); ++n) {
     std::snprintf(buf, sizeof buf, "%.9e,%.9e\n", c.t0 + static_cast<double>(n) / c.sample_rate, c.samples[n]);

@@ -11,17 +11,45 @@
 // WAV: RIFF/WAVE, 16- or 24-bit PCM or 32-bit IEEE float (also as WAVE_FORMAT_EXTENSIBLE),
 // mono or the first channel of several; t0 = 0; PCM values are read as full-scale fractions.
 // Every error is an InputError naming the file and line (CSV) or byte offset (WAV).
+//
+// Metadata (what `simulate --write-captures` knows about the stream), all optional:
+//   CSV header lines "Scene,NAME", "Family,NAME", "Code Sent,J" (0: a periodic train),
+//   "True Distance (m),D", "Speed of Sound (m/s),C", "Sample Rate (Hz),FS", "Burst Period (s),T";
+//   a sidecar JSON STEM.json beside STEM.csv / STEM.wav with the keys scene, family, code_sent,
+//   true_distance_m, speed_of_sound, sample_rate, period_s.
+// read_capture() takes the CSV header lines, then fills what they lack from the sidecar (a
+// WAV's only source). A value that is malformed or out of range is an InputError naming the
+// file, the line or key and the valid range.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace ranging {
 
+struct CaptureMeta {
+  std::optional<std::string> scene, family;
+  std::optional<int> code_sent;               // 1-based j; 0 = a periodic train of codes 1..eta
+  std::optional<double> true_distance_m;      // 0 < d <= 1000
+  std::optional<double> speed_of_sound;       // m/s, 100..10000
+  std::optional<double> sample_rate;          // Hz, as recorded (the data's own rate is Capture::sample_rate)
+  std::optional<double> period_s;             // periodic trains: the burst period
+  std::string source;                         // where the metadata came from: "csv header", "FILE.json", both, or ""
+  bool empty() const {
+    return !scene && !family && !code_sent && !true_distance_m && !speed_of_sound && !sample_rate && !period_s;
+  }
+};
+
 struct Capture {
   double sample_rate = 0;        // Hz
   double t0 = 0;                 // time of samples[0], s (0 = start of the first burst)
   std::vector<double> samples;   // volts (CSV, float WAV) or full-scale fractions (PCM WAV)
+  CaptureMeta meta;
 };
+
+// The sidecar JSON's text for meta, and its parse (InputError naming origin and the key).
+std::string capture_meta_json(const CaptureMeta& meta);
+CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& origin);
 
 // By extension: .csv or .wav (case-insensitive); anything else is refused.
 Capture read_capture(const std::string& path);
@@ -34,6 +62,7 @@ enum class WavFormat { Pcm16, Pcm24, Float32 };
 // then time,volts rows with 9 significant digits. WAV: the sample rate rounded to an integer
 // (refused if it is not one); PCM scales by 1/full_scale and saturates, float writes volts.
 // Both write to PATH.tmp and rename, so a failure leaves no partial file.
+// capture_csv writes c.meta's fields as header lines (before "TIME,CH1").
 std::string capture_csv(const Capture& c);
 std::string capture_wav(const Capture& c, WavFormat fmt, double full_scale = 1.0);
 void write_file_atomic(const std::string& path, const std::string& content);

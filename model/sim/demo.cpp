@@ -96,6 +96,7 @@ std::vector<DemoRow> run_demo(const DemoParams& p,
     if (progress) progress(++done, total);
   }
 
+  PearsonBank bank(templates);
   std::vector<DemoRow> rows;
   std::uint64_t seed = p.seed;
   for (double d : p.distances_m) {
@@ -122,20 +123,24 @@ std::vector<DemoRow> run_demo(const DemoParams& p,
       };
       fill(row.flt, pass.flt, offset_flt);
       fill(row.fix, pass.fix, offset_fix);
-      // The paper's decoder: Pearson of the filtered burst with every received template,
-      // aligned at the float receiver's time of flight (or the true one if nothing was found).
+      // The paper's decoder: the Pearson matched filter (eq. 9 over lags, +-L chips around the
+      // float receiver's time of flight, or the true one if nothing was found); u by eq. 10.
       const double tof_samples = row.flt.detected ? row.flt.tof_s * rc.fs : delay;
       const long start = std::lround(tof_samples);
-      if (start >= 0 && static_cast<std::size_t>(start) + template_len <= pass.filtered.size()) {
-        std::span<const double> seg(pass.filtered.data() + start, template_len);
+      const long reach = static_cast<long>(window);
+      const long n = static_cast<long>(pass.filtered.size());
+      if (start - reach <= n - static_cast<long>(template_len) && start + reach >= 0) {
+        const auto best = bank.search(pass.filtered, start - reach, start + reach);
         std::vector<double> rhos;
-        for (const auto& t : templates) rhos.push_back(pearson(seg, t));
+        for (const auto& b : best) rhos.push_back(b.rho);
         const Distinguishability dist = distinguishability(rhos);
         row.pearson_decoded = dist.best_code;
         row.rho_max = dist.rho_max;
         row.rho_submax = dist.rho_submax;
-        row.u = dist.u;
-        row.energy = energy(seg);
+        row.u = u_for_sent(rhos, row.code);
+      }
+      if (start >= 0 && static_cast<std::size_t>(start) + template_len <= pass.filtered.size()) {
+        row.energy = energy(std::span<const double>(pass.filtered.data() + start, template_len));
       }
       rows.push_back(row);
       if (progress) progress(++done, total);

@@ -2,7 +2,9 @@
 // The main job at this stage: every code of a family is encoded (BPSK, eq. 5/6), sent through
 // the simple channel (delay d/c, 1/d spreading, resonant TX and RX transducers, white noise),
 // filtered and decoded by the float and the bit-accurate fixed receiver; the paper's Pearson
-// decoder with received templates (eq. 9) gives rho_max, rho_submax and u (eq. 12).
+// decoder (a matched filter: eq. 9 maximized over lags within +-L chips of the float ToF, with
+// received templates) gives rho_max, rho_submax and u = rho(sent) - max rho(other) (eq. 10,
+// negative on a Pearson misdecode).
 //
 // Time of flight: the receiver reports the correlation peak's sample; the latency of the
 // chain (code window, filter and transducer group delay) is calibrated per code and per
@@ -40,9 +42,10 @@ struct DemoRow {
   int code = 0;               // sent, 1-based
   double distance_m = 0;      // true
   DemoDecode flt, fix;
-  // The paper's decoder (Pearson with received templates at the float ToF).
+  // The paper's decoder (Pearson matched filter with received templates around the float ToF).
   int pearson_decoded = 0;
-  double rho_max = 0, rho_submax = 0, u = 0;
+  double rho_max = 0, rho_submax = 0;
+  double u = 0;               // eq. 10: rho(sent) - max rho(other codes)
   double energy = 0;          // sum of squares of the filtered received burst
   std::uint64_t overflows = 0;  // fixed-point saturation events (input, filter, correlator)
 };

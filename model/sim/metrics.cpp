@@ -2,13 +2,177 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <new>
 #include <limits>
 #include <sstream>
 #include <string>
 
+#include <fftw3.h>
+
 #include "model/base/error.hpp"
 
 namespace ranging {
+
+namespace {
+
+// Valid lag range [lo, hi] of an N-sample reference over x, or InputError.
+std::pair<long, long> valid_lags(std::size_t nx, std::size_t n, long lo, long hi) {
+  if (n < 2) throw InputError("pearson search: reference has " + std::to_string(n) + " samples; needs >= 2");
+  const long top = static_cast<long>(nx) - static_cast<long>(n);
+  const long a = std::max(lo, 0L), b = std::min(hi, top);
+  if (a > b) {
+    throw InputError("pearson search: no lag of [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                     "] keeps a " + std::to_string(n) + "-sample reference inside a " + std::to_string(nx) +
+                     "-sample signal");
+  }
+  return {a, b};
+}
+
+}  // namespace
+
+LagRho pearson_over_lags(std::span<const double> x, std::span<const double> t, long lo, long hi) {
+  const auto [a, b] = valid_lags(x.size(), t.size(), lo, hi);
+  LagRho best{-2.0, a};
+  for (long k = a; k <= b; ++k) {
+    const double r = pearson(x.subspan(static_cast<std::size_t>(k), t.size()), t);
+    if (r > best.rho) best = {r, k};
+  }
+  return best;
+}
+
+struct PearsonBank::Plan {
+  std::size_t nfft = 0;
+  double* in = nullptr;
+  fftw_complex* spec = nullptr;
+  fftw_complex* prod = nullptr;
+  double* out = nullptr;
+  fftw_plan fwd = nullptr, inv = nullptr;
+  std::vector<std::vector<std::complex<double>>> tspec;  // conj FFT of each centred template
+  ~Plan() {
+    if (fwd) fftw_destroy_plan(fwd);
+    if (inv) fftw_destroy_plan(inv);
+    fftw_free(in);
+    fftw_free(spec);
+    fftw_free(prod);
+    fftw_free(out);
+  }
+};
+
+PearsonBank::PearsonBank(std::vector<std::vector<double>> templates) {
+  if (templates.empty()) throw InputError("PearsonBank: no references");
+  n_ = templates.front().size();
+  if (n_ < 2) throw InputError("PearsonBank: references have " + std::to_string(n_) + " samples; need >= 2");
+  for (auto& t : templates) {
+    if (t.size() != n_) {
+      throw InputError("PearsonBank: references have lengths " + std::to_string(n_) + " and " +
+                       std::to_string(t.size()) + "; they must be equal");
+    }
+    double m = 0;
+    for (double v : t) m += v;
+    m /= static_cast<double>(n_);
+    double ss = 0;
+    for (double& v : t) {
+      v -= m;
+      ss += v * v;
+    }
+    tnorm_.push_back(std::sqrt(ss));
+    t_.push_back(std::move(t));
+  }
+}
+
+PearsonBank::~PearsonBank() = default;
+
+PearsonBank::Plan& PearsonBank::plan(std::size_t nfft) {
+  if (auto it = plans_.find(nfft); it != plans_.end()) return *it->second;
+  auto p = std::make_unique<Plan>();
+  p->nfft = nfft;
+  const std::size_t nc = nfft / 2 + 1;
+  p->in = fftw_alloc_real(nfft);
+  p->out = fftw_alloc_real(nfft);
+  p->spec = fftw_alloc_complex(nc);
+  p->prod = fftw_alloc_complex(nc);
+  if (!p->in || !p->out || !p->spec || !p->prod) throw std::bad_alloc();
+  const int n = static_cast<int>(nfft);
+  p->fwd = fftw_plan_dft_r2c_1d(n, p->in, p->spec, FFTW_ESTIMATE);
+  p->inv = fftw_plan_dft_c2r_1d(n, p->prod, p->out, FFTW_ESTIMATE);
+  for (const auto& t : t_) {
+    std::fill(p->in, p->in + nfft, 0.0);
+    std::copy(t.begin(), t.end(), p->in);
+    fftw_execute(p->fwd);
+    std::vector<std::complex<double>> c(nc);
+    for (std::size_t i = 0; i < nc; ++i) c[i] = std::conj(std::complex<double>(p->spec[i][0], p->spec[i][1]));
+    p->tspec.push_back(std::move(c));
+  }
+  return *plans_.emplace(nfft, std::move(p)).first->second;
+}
+
+std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long hi) {
+  const auto [a, b] = valid_lags(x.size(), n_, lo, hi);
+  const std::size_t lags = static_cast<std::size_t>(b - a) + 1;
+  const std::size_t w = lags + n_ - 1;  // window x[a, b + N)
+  std::size_t nfft = 64;
+  while (nfft < w) nfft *= 2;
+  Plan& p = plan(nfft);
+  const double* xw = x.data() + a;
+  double mean = 0;
+  for (std::size_t i = 0; i < w; ++i) mean += xw[i];
+  mean /= static_cast<double>(w);
+  // Segment sums of (x - mean) and its square by prefix sums.
+  std::vector<double> s1(w + 1, 0.0), s2(w + 1, 0.0);
+  for (std::size_t i = 0; i < w; ++i) {
+    const double v = xw[i] - mean;
+    s1[i + 1] = s1[i] + v;
+    s2[i + 1] = s2[i] + v * v;
+  }
+  const auto nd = static_cast<double>(n_);
+  std::vector<double> den(lags);
+  double den_max = 0;
+  for (std::size_t k = 0; k < lags; ++k) {
+    const double m1 = s1[k + n_] - s1[k];
+    const double var = std::max(0.0, (s2[k + n_] - s2[k]) - m1 * m1 / nd);
+    den[k] = var;
+    den_max = std::max(den_max, var);
+  }
+  std::fill(p.in, p.in + nfft, 0.0);
+  for (std::size_t i = 0; i < w; ++i) p.in[i] = xw[i] - mean;
+  fftw_execute(p.fwd);
+  const std::size_t nc = nfft / 2 + 1;
+  std::vector<LagRho> out;
+  for (std::size_t j = 0; j < t_.size(); ++j) {
+    for (std::size_t i = 0; i < nc; ++i) {
+      const std::complex<double> v = std::complex<double>(p.spec[i][0], p.spec[i][1]) * p.tspec[j][i];
+      p.prod[i][0] = v.real();
+      p.prod[i][1] = v.imag();
+    }
+    fftw_execute(p.inv);  // unnormalized: out = nfft * correlation
+    LagRho best{-2.0, a};
+    for (std::size_t k = 0; k < lags; ++k) {
+      double r = 0;
+      if (den[k] > 1e-24 * den_max && den[k] > 0 && tnorm_[j] > 0) {
+        r = std::clamp(p.out[k] / static_cast<double>(nfft) / (std::sqrt(den[k]) * tnorm_[j]), -1.0, 1.0);
+      }
+      if (r > best.rho) best = {r, a + static_cast<long>(k)};
+    }
+    out.push_back(best);
+  }
+  return out;
+}
+
+double u_for_sent(std::span<const double> rhos, int sent) {
+  if (rhos.size() < 2) {
+    throw InputError("rhos: " + std::to_string(rhos.size()) + " correlation(s) given; u needs at least 2 codes");
+  }
+  if (sent < 1 || static_cast<std::size_t>(sent) > rhos.size()) {
+    throw InputError("sent: code " + std::to_string(sent) + " is not in 1.." + std::to_string(rhos.size()));
+  }
+  double other = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < rhos.size(); ++i) {
+    require_finite("rhos[" + std::to_string(i) + "]", rhos[i]);
+    if (static_cast<int>(i) + 1 != sent) other = std::max(other, rhos[i]);
+  }
+  return rhos[static_cast<std::size_t>(sent - 1)] - other;
+}
 
 double pearson(std::span<const double> a, std::span<const double> b) {
   if (a.size() != b.size() || a.empty()) {
@@ -74,6 +238,103 @@ Duration duration_td(std::span<const double> x, double fs) {
     }
   }
   return {first, last, static_cast<double>(last - first) / fs};
+}
+
+StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std::size_t hi, std::size_t p0,
+                                  std::size_t p1, std::size_t guard, double fs) {
+  require_in_range("fs", fs, 1e-9, 1e12);
+  if (!(lo < hi && hi <= x.size() && p0 < p1 && p1 <= x.size())) {
+    throw InputError("duration_td_stream: ranges [" + std::to_string(lo) + ", " + std::to_string(hi) + ") and [" +
+                     std::to_string(p0) + ", " + std::to_string(p1) + ") must be non-empty and inside the " +
+                     std::to_string(x.size()) + "-sample stream");
+  }
+  double b = 0;
+  for (std::size_t i = p0; i < p1; ++i) b = std::max(b, std::abs(x[i]));
+  require_finite("duration_td_stream: peak |x|", b);
+  if (b == 0.0) throw InputError("duration_td_stream: burst window is all zero; T_d needs a non-zero peak");
+  StreamDuration d;
+  const std::size_t n0 = lo > 2000 ? lo - 2000 : 0;
+  if (lo - n0 >= 100) {
+    std::vector<double> m;
+    for (std::size_t i = n0; i < lo; ++i) m.push_back(std::abs(x[i]));
+    std::nth_element(m.begin(), m.begin() + static_cast<long>(m.size() / 2), m.end());
+    d.noise_rms = m[m.size() / 2] / 0.6744897501960817;
+  }
+  d.threshold = b / 10.0;
+  if (4.5 * d.noise_rms > d.threshold) {
+    d.threshold = 4.5 * d.noise_rms;
+    d.noise_limited = true;
+  }
+  // The burst's peak, then outwards until `guard` consecutive samples are at or below a.
+  std::size_t pk = p0;
+  for (std::size_t i = p0; i < p1; ++i) {
+    if (std::abs(x[i]) > std::abs(x[pk])) pk = i;
+  }
+  pk = std::clamp(pk, lo, hi - 1);
+  const std::size_t gap = std::max<std::size_t>(guard, 1);
+  std::size_t last = pk, first = pk, quiet = 0;
+  bool ended = false, began = false;
+  for (std::size_t i = pk + 1; i < hi; ++i) {
+    if (std::abs(x[i]) > d.threshold) {
+      last = i;
+      quiet = 0;
+    } else if (++quiet >= gap) {
+      ended = true;
+      break;
+    }
+  }
+  quiet = 0;
+  for (std::size_t i = pk; i-- > lo;) {
+    if (std::abs(x[i]) > d.threshold) {
+      first = i;
+      quiet = 0;
+    } else if (++quiet >= gap) {
+      began = true;
+      break;
+    }
+  }
+  if (std::abs(x[pk]) <= d.threshold) first = last = pk;  // the noise floor hides the whole burst
+  d.first = first;
+  d.last = last;
+  d.seconds = static_cast<double>(last - first) / fs;
+  d.clipped = !(ended && began);
+  return d;
+}
+
+namespace {
+std::vector<double> ranks(std::span<const double> v) {
+  std::vector<std::size_t> idx(v.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return v[a] < v[b]; });
+  std::vector<double> r(v.size());
+  for (std::size_t i = 0; i < idx.size();) {
+    std::size_t j = i;
+    while (j + 1 < idx.size() && v[idx[j + 1]] == v[idx[i]]) ++j;
+    const double mean = 0.5 * static_cast<double>(i + j) + 1.0;
+    for (std::size_t k = i; k <= j; ++k) r[idx[k]] = mean;
+    i = j + 1;
+  }
+  return r;
+}
+}  // namespace
+
+double spearman(std::span<const double> a, std::span<const double> b) {
+  if (a.size() != b.size() || a.size() < 2) {
+    throw InputError("spearman: samples have sizes " + std::to_string(a.size()) + " and " +
+                     std::to_string(b.size()) + "; they must be equal and >= 2");
+  }
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    require_finite("spearman: a[" + std::to_string(i) + "]", a[i]);
+    require_finite("spearman: b[" + std::to_string(i) + "]", b[i]);
+  }
+  const auto ra = ranks(a), rb = ranks(b);
+  double va = 0, vb = 0;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    va += std::abs(ra[i] - ra[0]);
+    vb += std::abs(rb[i] - rb[0]);
+  }
+  if (va == 0 || vb == 0) return std::numeric_limits<double>::quiet_NaN();
+  return pearson(ra, rb);
 }
 
 int eta_required(double max_distance_m, double period_s, double c) {

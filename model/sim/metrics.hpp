@@ -1,10 +1,14 @@
 #pragma once
 // The paper's figures of merit and system equations, as free functions:
-// correlation (eq. 9), distinguishability (eq. 12), received energy (Table 4), received
-// duration T_d (section 2.2), required number of codes (eq. 3), maximum measurement rate
-// (eq. 4) and the vertical blade-tip distance from two slant measurements (eq. 1).
+// correlation (eq. 9) and the matched filter over lags (section 3.3.2), distinguishability
+// (eqs. 10 and 12), received energy (Table 4), received duration T_d (section 2.2), required
+// number of codes (eq. 3), maximum measurement rate (eq. 4) and the vertical blade-tip
+// distance from two slant measurements (eq. 1).
 #include <cstddef>
+#include <map>
+#include <memory>
 #include <span>
+#include <vector>
 
 namespace ranging {
 
@@ -12,9 +16,57 @@ namespace ranging {
 // InputError if the lengths differ or are 0; returns 0 if either has zero variance.
 double pearson(std::span<const double> a, std::span<const double> b);
 
-// Eq. 12: u = rho_max - rho_submax over the correlations of one received signal with
-// every reference of a family; best_code (1-based) is the argmax = the decoded code.
-// Ties go to the lowest index. InputError unless rhos has >= 2 finite values.
+// The paper's decoder is a matched filter (section 3.3.2): the filtered received signal is
+// cross-correlated with each reference, so each reference takes its best Pearson coefficient
+// over time shifts. For a reference t of N samples and a signal x:
+//   rho(k) = pearson(x[k .. k+N), t)              (eq. 9 at lag k)
+//   rho    = max over k in [lo, hi] of rho(k)     (lags whose segment leaves x are not searched)
+// The search window [lo, hi] is the caller's: the scene simulator and `decode` search +-L chips
+// (L = code length) around the detected arrival (docs/signal-model.md).
+struct LagRho {
+  double rho = 0;  // the largest rho(k) over the window
+  long lag = 0;    // its k (first one on ties): x index of the best segment's first sample
+};
+// Direct O(N (hi - lo)) form, the definition itself. InputError if t has < 2 samples or no lag
+// of [lo, hi] keeps the segment inside x.
+LagRho pearson_over_lags(std::span<const double> x, std::span<const double> t, long lo, long hi);
+
+// The same search for a bank of references of one length at once, by FFT cross-correlation
+// (FFTW, double precision; agrees with pearson_over_lags to ~1e-12, tested). Segment sums of x
+// come from prefix sums of x minus the window's mean. A segment whose variance is below 1e-24
+// of the window's largest gives rho 0 there (as pearson() does for zero variance).
+// Not thread-safe per object (it owns FFTW buffers); plans are made once per transform size.
+class PearsonBank {
+ public:
+  // InputError if templates is empty, their lengths differ, or are < 2.
+  explicit PearsonBank(std::vector<std::vector<double>> templates);
+  ~PearsonBank();
+  PearsonBank(const PearsonBank&) = delete;
+  PearsonBank& operator=(const PearsonBank&) = delete;
+  std::size_t length() const { return n_; }
+  std::size_t size() const { return t_.size(); }
+  // One LagRho per template. InputError as pearson_over_lags.
+  std::vector<LagRho> search(std::span<const double> x, long lo, long hi);
+
+ private:
+  struct Plan;
+  Plan& plan(std::size_t nfft);
+  std::size_t n_ = 0;
+  std::vector<std::vector<double>> t_;  // centred templates
+  std::vector<double> tnorm_;           // sqrt(sum tc^2)
+  std::map<std::size_t, std::unique_ptr<Plan>> plans_;
+};
+
+// Eq. 10 for one received signal: u = rho(code sent) - max over the other codes j of rho_j,
+// rho_j the matched-filter coefficients (1-based sent). u < 0 exactly when the Pearson decoder
+// (argmax) picks another code; u = 0 when another code ties. InputError unless rhos has >= 2
+// finite values and 1 <= sent <= rhos.size().
+double u_for_sent(std::span<const double> rhos, int sent);
+
+// Eq. 12 as the decoder sees it (no knowledge of the code sent): rho_max - rho_submax over the
+// correlations of one received signal with every reference of a family; best_code (1-based) is
+// the argmax = the decoded code, and u >= 0 is the decoder's margin (equal to eq. 10's u when
+// the decode is right). Ties go to the lowest index. InputError unless rhos has >= 2 finite values.
 struct Distinguishability {
   int best_code;
   double rho_max;
@@ -34,6 +86,34 @@ struct Duration {
   double seconds;
 };
 Duration duration_td(std::span<const double> x, double fs);
+
+// Section 2.2 on a stream, until the signal really ends. b = max |x| over the burst window
+// [p0, p1) (at sample pk); the threshold is a = max(b/10, 4.5 sigma), sigma the noise floor
+// (the stream's robust rms, median|x|/0.6745, over up to 2000 samples before lo; 0 when fewer
+// than 100 are there), so Gaussian noise alone crosses it with probability ~7e-6 per sample.
+// From pk outwards, the signal ends at the first run of `guard` consecutive samples with
+// |x| <= a: last = the last sample above a before that run after pk, first = the first one
+// before the run before pk (the paper's "subsequent sampling points all below the threshold",
+// where a noise spike far after the end is not the signal; dips inside a burst, at phase
+// flips, are shorter than the guard of one or two chips).
+//   clipped       no such run fits between pk and lo or hi (the end of the stream or the
+//                 next burst): the search range may have cut T_d;
+//   noise_limited the noise floor, not b/10, set a (T_d is then shorter than at high SNR;
+//                 T_d = 0 if even the peak is below it).
+// InputError if fs <= 0, the ranges are empty or outside x, or x is all zero over [p0, p1).
+struct StreamDuration {
+  std::size_t first = 0, last = 0;
+  double seconds = 0;
+  double threshold = 0, noise_rms = 0;
+  bool clipped = false, noise_limited = false;
+};
+StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std::size_t hi, std::size_t p0,
+                                  std::size_t p1, std::size_t guard, double fs);
+
+// Spearman's rank correlation of two equal-length samples: the Pearson coefficient of their
+// ranks, tied values taking the mean of their ranks. InputError if the lengths differ or are
+// < 2; NaN if either sample is constant (no ranking).
+double spearman(std::span<const double> a, std::span<const double> b);
 
 // Eq. 3: eta >= L/(T*c), the smallest integer number of codes. Ratios within 1e-9
 // (relative) of an integer count as that integer, so rounding never demands an extra code.

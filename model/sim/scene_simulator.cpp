@@ -140,6 +140,7 @@ struct SceneSimulator::Link {
   std::size_t template_len = 0;
   std::vector<double> offset;                   // receiver latency per code, samples
   std::vector<std::vector<double>> templates;   // Pearson references per code
+  std::unique_ptr<PearsonBank> bank;            // their matched filter over lags
   std::map<std::pair<int, long long>, Sparse> cache;  // (code, distance in nm) -> clean burst
   std::map<long long, std::vector<double>> fir_cache;
   std::uint64_t overflows = 0;
@@ -276,6 +277,7 @@ struct SceneSimulator::Link {
     if (s.receiver.reference == "files") {
       for (std::size_t j = 0; j < eta; ++j) templates[j] = load_reference(static_cast<int>(j) + 1);
     }
+    bank = std::make_unique<PearsonBank>(templates);
   }
 
   std::vector<double> load_reference(int j) {
@@ -328,10 +330,19 @@ struct SceneSimulator::Link {
   std::vector<Detection> detections(const std::vector<Event>& ev, const std::vector<double>& filtered, double t0,
                                     const std::vector<Burst>& schedule) {
     std::vector<Detection> out;
-    for (const auto& e : ev) {
+    // T_d of a burst is searched up to the next detected burst's arrival (or the stream's end).
+    std::vector<long> starts;
+    for (const auto& e : ev) starts.push_back(std::lround(e.arrival - offset[static_cast<std::size_t>(e.code - 1)]));
+    for (std::size_t k = 0; k < ev.size(); ++k) {
+      const Event& e = ev[k];
+      long end = static_cast<long>(filtered.size());
+      for (long s2 : starts) {
+        if (s2 > starts[k] && s2 < end) end = s2;
+      }
       Detection d;
       d.code = e.code;
       d.score = e.score;
+      d.detector_margin = e.margin;
       const double a = e.arrival - offset[static_cast<std::size_t>(e.code - 1)];
       d.arrival_s = t0 + a / fs();
       double tx = 0;
@@ -343,29 +354,45 @@ struct SceneSimulator::Link {
         }
       }
       d.tof_s = d.arrival_s - tx;
-      metrics(d, filtered, std::lround(a));
+      metrics(d, filtered, std::lround(a), end);
       out.push_back(d);
     }
     return out;
   }
 
-  void metrics(Detection& d, const std::vector<double>& f, long start) const {
-    if (start < 0 || static_cast<std::size_t>(start) + template_len > f.size()) return;
-    std::span<const double> seg(f.data() + start, template_len);
-    std::vector<double> rhos;
-    for (const auto& t : templates) rhos.push_back(pearson(seg, t));
-    const Distinguishability dist = distinguishability(rhos);
-    d.pearson_code = dist.best_code;
-    d.rho_max = dist.rho_max;
-    d.rho_submax = dist.rho_submax;
-    d.u = dist.u;
-    d.energy = energy(seg);
-    const long lo = std::max<long>(0, start - spc);
-    const long hi = std::min<long>(static_cast<long>(f.size()), start + static_cast<long>((L + 4) * spc));
+  // The paper's metrics of the burst whose template starts at `start`, T_d searched to `end`.
+  void metrics(Detection& d, const std::vector<double>& f, long start, long end) const {
+    const long n = static_cast<long>(f.size());
+    const long W = static_cast<long>(template_len);
+    const long reach = static_cast<long>(L) * spc;  // the lag window: +-L chips
+    if (start - reach <= n - W && start + reach >= 0 && n >= W) {
+      const auto best = bank->search(f, start - reach, start + reach);
+      d.rho.clear();
+      for (const auto& b : best) d.rho.push_back(b.rho);
+      const Distinguishability dist = distinguishability(d.rho);
+      d.pearson_code = dist.best_code;
+      d.rho_max = dist.rho_max;
+      d.rho_submax = dist.rho_submax;
+      d.pearson_margin = dist.u;
+    }
+    if (start >= 0 && start + W <= n) {
+      d.energy = energy(std::span<const double>(f.data() + start, template_len));
+    }
+    const long lo = std::clamp<long>(start - 3 * spc, 0, n - 1);
+    const long hi = std::clamp<long>(end, lo + 1, n);
+    const long p0 = std::clamp<long>(start, 0, n - 1);
+    const long p1 = std::clamp<long>(start + W, p0 + 1, n);
     try {
-      d.td_s = duration_td(std::span<const double>(f.data() + lo, static_cast<std::size_t>(hi - lo)), fs()).seconds;
+      const StreamDuration td =
+          duration_td_stream(f, static_cast<std::size_t>(lo), static_cast<std::size_t>(hi),
+                             static_cast<std::size_t>(p0), static_cast<std::size_t>(p1),
+                             static_cast<std::size_t>(2 * spc), fs());
+      d.td_s = td.seconds;
+      d.td_clipped = td.clipped;
+      d.td_noise_limited = td.noise_limited;
     } catch (const InputError&) {
       d.td_s = 0;
+      d.td_clipped = true;
     }
   }
 };
@@ -523,8 +550,13 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
             m.distance_m = m.det.tof_s * lk.c();
             m.error_m = m.distance_m - d;
           } else {
-            lk.metrics(m.det, f, std::lround(truth));  // the paper's metrics at the true alignment
+            // The paper's metrics at the true alignment, T_d searched to the next burst.
+            long end = static_cast<long>(f.size());
+            if (k + 1 < train.size()) end = std::lround((train[k + 1].tx_s + d / lk.c()) * s.fs);
+            lk.metrics(m.det, f, std::lround(truth), end);
           }
+          m.pearson_error = m.det.rho.empty() || m.det.pearson_code != m.code_sent;
+          m.u = m.det.rho.empty() ? std::nan("") : u_for_sent(m.det.rho, m.code_sent);
           rows.push_back(m);
         }
         for (bool u : used) fa += !u;
@@ -593,7 +625,7 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
   const auto eta = static_cast<std::size_t>(s.eta);
   double dmax = 0;
   for (const auto& r : rows) dmax = std::max(dmax, r.true_distance_m);
-  std::vector<double> usum(eta, 0), un(eta, 0), esum(eta, 0), en(eta, 0);
+  std::vector<double> usum(eta, 0), un(eta, 0), esum(eta, 0), en(eta, 0), msum(eta, 0), mn(eta, 0);
   std::map<std::pair<int, long long>, std::pair<double, int>> td;  // (code, d) -> sum, n
   double se = 0;
   std::size_t nse = 0;
@@ -602,14 +634,24 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
     ++s.measurements;
     const auto j = static_cast<std::size_t>(r.code_sent - 1);
     if (!r.detected) ++s.missed;
-    if (!r.detected || r.det.code != r.code_sent) {
-      ++s.decode_errors;
-    } else {
+    const bool det_err = !r.detected || r.det.code != r.code_sent;
+    s.detector_errors += det_err;
+    s.pearson_errors += r.pearson_error;
+    s.decode_errors += det_err || r.pearson_error;
+    s.td_clipped += r.det.td_clipped;
+    s.td_noise_limited += r.det.td_noise_limited;
+    if (!det_err) {
       se += r.error_m * r.error_m;
       ++nse;
     }
-    usum[j] += r.det.u;
-    un[j] += 1;
+    if (r.detected) {
+      msum[j] += r.det.detector_margin;
+      mn[j] += 1;
+    }
+    if (std::isfinite(r.u)) {
+      usum[j] += r.u;
+      un[j] += 1;
+    }
     if (r.true_distance_m == dmax) {
       esum[j] += r.det.energy;
       en[j] += 1;
@@ -619,19 +661,27 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
     t.second += 1;
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
   s.u_per_code.assign(eta, nan);
   s.energy_per_code.assign(eta, nan);
   s.td_per_code.assign(eta, nan);
-  s.u_min = s.energy_min = std::numeric_limits<double>::infinity();
+  s.detector_margin_per_code.assign(eta, nan);
+  s.u_min = s.energy_min = s.detector_margin_min = inf;
+  double u_max = -inf;
   s.td_max_s = 0;
   for (std::size_t j = 0; j < eta; ++j) {
     if (un[j] > 0) {
       s.u_per_code[j] = usum[j] / un[j];
       s.u_min = std::min(s.u_min, s.u_per_code[j]);
+      u_max = std::max(u_max, s.u_per_code[j]);
     }
     if (en[j] > 0) {
       s.energy_per_code[j] = esum[j] / en[j];
       s.energy_min = std::min(s.energy_min, s.energy_per_code[j]);
+    }
+    if (mn[j] > 0) {
+      s.detector_margin_per_code[j] = msum[j] / mn[j];
+      s.detector_margin_min = std::min(s.detector_margin_min, s.detector_margin_per_code[j]);
     }
   }
   for (const auto& [key, v] : td) {
@@ -640,7 +690,11 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
     if (std::isnan(s.td_per_code[j]) || mean > s.td_per_code[j]) s.td_per_code[j] = mean;
     s.td_max_s = std::max(s.td_max_s, mean);
   }
-  if (s.measurements == 0) s.u_min = s.energy_min = nan;
+  if (!std::isfinite(s.u_min)) s.u_min = nan;
+  if (!std::isfinite(s.energy_min)) s.energy_min = nan;
+  if (!std::isfinite(s.detector_margin_min)) s.detector_margin_min = nan;
+  // max/min is a ratio of positive u only; a group with u_min <= 0 (misdecodes) has none.
+  s.u_max_over_min = std::isfinite(s.u_min) && s.u_min > 0 ? u_max / s.u_min : nan;
   s.error_rate = s.measurements ? static_cast<double>(s.decode_errors) / static_cast<double>(s.measurements) : 0;
   s.rmse_m = nse ? std::sqrt(se / static_cast<double>(nse)) : nan;
   const double L = scene.range_l();

@@ -14,9 +14,18 @@
 //
 // Time of flight: the receiver's latency is calibrated once per code on a noise-free burst
 // through the scene's deterministic stages at receiver.calibration_distance_m (the paper's
-// system measures a known distance the same way). The paper's metrics (Pearson rho with
-// received templates, u, energy, T_d) are computed on the float bandpass output at the
-// detected alignment, whatever the receiver precision.
+// system measures a known distance the same way). The paper's metrics are computed on the
+// float bandpass output, whatever the receiver precision:
+//   Pearson  the matched filter of section 3.3.2: each received template's rho (eq. 9) is
+//            maximized over lags within +-L chips (L = code length) of the detected arrival
+//            (model/sim/metrics.hpp PearsonBank); the argmax is the Pearson decoder's code;
+//   u        eq. 10 for the code sent: rho(sent) - max rho(other codes), negative on a Pearson
+//            misdecode (Measurement::u); Detection::pearson_margin is rho_max - rho_submax;
+//   energy   sum of squares over the template span at the detected arrival;
+//   T_d      section 2.2 from one chip before the arrival to the end of the stream or the next
+//            detected burst, threshold max(b/10, 4.5 x the noise floor) (duration_td_stream),
+//            flagged when the search range clips it or the noise floor set the threshold.
+// Decode errors count the receiver's misses and misdecodes and the Pearson decoder's misdecodes.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -40,11 +49,17 @@ struct Detection {
   int code = 0;            // 1-based j (receiver bank)
   double arrival_s = 0;    // calibrated arrival time from t = 0 (start of the first burst)
   double tof_s = 0;        // arrival - transmission time of the burst that carried code j
-  double score = 0;        // receiver rho^2
-  int pearson_code = 0;    // the paper's Pearson decoder (eq. 9) at this alignment
-  double rho_max = 0, rho_submax = 0, u = 0;
+  double score = 0;        // receiver rho^2 at the peak (hardware detector)
+  double detector_margin = 0;  // receiver rho^2(best) - rho^2(second) at the peak
+  // The paper's Pearson matched filter (eq. 9 over lags, +-L chips around the arrival).
+  std::vector<double> rho;     // per code j-1: best rho over the lag window (empty: no window)
+  int pearson_code = 0;        // argmax of rho (0 when rho is empty)
+  double rho_max = 0, rho_submax = 0;
+  double pearson_margin = 0;   // rho_max - rho_submax (eq. 12 as the decoder sees it, >= 0)
   double energy = 0;       // V^2, sum of squares of the filtered signal over the burst window
   double td_s = 0;         // T_d of the filtered signal around the burst (section 2.2)
+  bool td_clipped = false;        // the search range may have cut T_d
+  bool td_noise_limited = false;  // the noise floor, not b/10, set the T_d threshold
 };
 
 struct Measurement {
@@ -57,17 +72,27 @@ struct Measurement {
   Detection det;               // valid when detected
   double distance_m = 0;       // tof * c
   double error_m = 0;          // distance_m - true_distance_m
+  double u = 0;                // eq. 10: rho(code_sent) - max rho(other), < 0 on a Pearson misdecode
+  bool pearson_error = false;  // the Pearson decoder picked another code (or had no window)
 };
 
 struct FamilySummary {
   std::string family;
   int eta = 0;
+  // decode_errors: measurements that the receiver missed or misdecoded, or that the Pearson
+  // decoder misdecoded (the union; the two parts below).
   std::size_t measurements = 0, decode_errors = 0, missed = 0, false_alarms = 0;
+  std::size_t detector_errors = 0;       // receiver (hardware detector): missed or wrong code
+  std::size_t pearson_errors = 0;        // Pearson matched filter: wrong code (u < 0 or no window)
+  std::size_t td_clipped = 0, td_noise_limited = 0;  // T_d measurements flagged
   double error_rate = 0, rmse_m = 0;
-  std::vector<double> u_per_code;        // mean u over all distances and repeats (Fig. 14)
+  std::vector<double> u_per_code;        // mean eq. 10 u over all distances and repeats (Fig. 14)
   std::vector<double> energy_per_code;   // mean energy at the largest distance (Fig. 15)
   std::vector<double> td_per_code;       // max over distances of the mean T_d per distance
+  std::vector<double> detector_margin_per_code;  // mean receiver rho^2 margin (detected bursts)
   double u_min = 0, energy_min = 0, td_max_s = 0, vmax_hz = 0;
+  double u_max_over_min = 0;             // max/min of u_per_code (paper: 1.19-1.33 M, 1.85-5.85 Gold)
+  double detector_margin_min = 0;        // min over codes of detector_margin_per_code
   std::uint64_t overflows = 0;           // fixed precision: saturations and wraps
 };
 
