@@ -13,6 +13,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "model/base/error.hpp"
@@ -108,8 +109,18 @@ TEST(FastQuantizer, MatchesFxQuantizeForEveryModeShiftAndFormat) {
 
 TEST(BandpassBlock, MatchesReferenceCascadeInEveryModeWithOverflowsAndAnySectionCount) {
   std::mt19937_64 rng(11);
-  for (int order : {2, 5, 9}) {  // 9 sections: beyond the specialized kernels
-    const SosFilter design = design_bandpass(BandpassSpec{}, FilterType::Butterworth, order);
+  // Butterworth: b0 [1, 0, -1] numerators (the one-multiply kernel); elliptic: general
+  // numerators; 9 sections: beyond the specialized kernels.
+  const std::pair<FilterType, int> designs[] = {
+      {FilterType::Butterworth, 2}, {FilterType::Butterworth, 5}, {FilterType::Butterworth, 9},
+      {FilterType::Elliptic, 3}};
+  for (const auto& [type, order] : designs) {
+    const SosFilter design = design_bandpass(BandpassSpec{}, type, order);
+    bool symmetric = true;
+    for (const Biquad& b : design.sections) symmetric = symmetric && b.b1 == 0;
+    if (type == FilterType::Elliptic) {
+      EXPECT_FALSE(symmetric) << "the elliptic design must exercise b1 != 0";
+    }
     for (Rounding r : kRoundings) {
       for (Overflow o : kOverflows) {
         BandpassFixedConfig cfg;

@@ -191,6 +191,10 @@ BandpassFixed::BandpassFixed(const SosFilter& filter, const BandpassFixedConfig&
   data_fmt_ = FixedFormat{config.data_bits, config.data_frac, true, config.rounding, config.overflow};
   input_shift_ = config.data_frac - (config.input_bits - 1);
   data_range_ = fx_range(data_fmt_);
+  // The folded rounding bias needs |acc| < 2^61 (see bandpass_kernel) and a dropped bit.
+  bias_ok_ = min_acc_bits(config, coef_) <= 62 && config.coef_frac >= 1;
+  sym_ok_ = config.data_bits <= 62 && config.data_frac <= 61;
+  for (const auto& c : coef_) sym_ok_ = sym_ok_ && c[1] == 0 && c[2] == -c[0];
   reset();
 }
 
@@ -211,41 +215,67 @@ void BandpassFixed::throw_input_range(std::int64_t x_in) const {
 namespace {
 
 
-// One block through N sections, sample-major, state and coefficients in locals. Exact: every
-// partial sum of the accumulator is bounded by sum |b_i| max|x| + sum |a_i| max|y|, which
-// validate() proved fits acc_bits <= 64 bits, so the int64 arithmetic never overflows; the
-// aligned input |x| <= 2^data_frac <= 2^62. The a1 y1 term is added last: it is the only
-// term on the loop-carried path from y[n-1].
-template <int N, Rounding R, Overflow O, class SectionState>
+// One block through N sections, sample-major, state in locals. Exact: every partial sum of the
+// accumulator is bounded by sum |b_i| max|x| + sum |a_i| max|y| < 2^(acc_min - 1), acc_min =
+// bandpass_min_acc_bits <= acc_bits <= 64 (validate()), so the int64 arithmetic never
+// overflows; the aligned input |x| <= 2^data_frac <= 2^62. Section k's input history is
+// section k-1's output history (x1[k] = y1[k-1], x2[k] = y2[k-1]), so only section 0 keeps
+// its own. The a1 y1 term is added last: it is the only one on the loop-carried path.
+// Bias (RoundHalfUp only, when acc_min <= 62): round half up of acc / 2^s is
+// floor((acc + 2^(s-1)) / 2^s), and the constant 2^(s-1) <= 2^61 is folded into the terms off
+// the critical path; |acc| + 2^(s-1) < 2^61 + 2^61 cannot overflow.
+// Sym (every section's numerator is b0 [1, 0, -1], as a Butterworth/Chebyshev bandpass's are,
+// and data_bits <= 62, data_frac <= 61 so every section input |x| < 2^61): b0 x + b2 x2 =
+// b0 (x - x2) exactly, |x - x2| < 2^62, one multiply instead of three.
+template <int N, Rounding R, Overflow O, bool Bias, bool Sym, class SectionState>
 void bandpass_kernel(const std::int64_t* in, std::int64_t* out, std::size_t len, std::int64_t in_scale,
                      const std::vector<std::vector<std::int64_t>>& coef, std::vector<SectionState>& state,
                      int qshift, const FxRange& range, OverflowCounter& counter) {
-  std::int64_t b0[N], b1[N], b2[N], a1[N], a2[N], x1[N], x2[N], y1[N], y2[N];
+  std::int64_t b0[N], b1[N], b2[N], a1[N], a2[N], y1[N], y2[N];
   for (int k = 0; k < N; ++k) {
     b0[k] = coef[k][0];
     b1[k] = coef[k][1];
     b2[k] = coef[k][2];
     a1[k] = coef[k][3];
     a2[k] = coef[k][4];
-    x1[k] = state[k].x1;
-    x2[k] = state[k].x2;
     y1[k] = state[k].y1;
     y2[k] = state[k].y2;
   }
+  std::int64_t in1 = state[0].x1, in2 = state[0].x2;
+  const std::int64_t bias = Bias ? (std::int64_t{1} << (qshift - 1)) : 0;
   for (std::size_t i = 0; i < len; ++i) {
     std::int64_t x = in[i] * in_scale;
+    std::int64_t x1 = in1, x2 = in2;
+    in2 = in1;
+    in1 = x;
     for (int k = 0; k < N; ++k) {
-      const std::int64_t part = b0[k] * x + b1[k] * x1[k] + b2[k] * x2[k] - a2[k] * y2[k];
-      const std::int64_t y = fx_quantize_fast<R, O>(part - a1[k] * y1[k], qshift, range, counter);
-      x2[k] = x1[k];
-      x1[k] = x;
+      std::int64_t part;
+      if constexpr (Sym) {
+        part = b0[k] * (x - x2) - a2[k] * y2[k] + bias;
+      } else {
+        part = b0[k] * x + b1[k] * x1 + b2[k] * x2 - a2[k] * y2[k] + bias;
+      }
+      const std::int64_t acc = part - a1[k] * y1[k];
+      std::int64_t y;
+      if constexpr (Bias) {
+        y = acc >> qshift;
+        if (y < range.lo || y > range.hi) [[unlikely]] y = fx_overflow_slow(y, range, O, counter);
+      } else {
+        y = fx_quantize_fast<R, O>(acc, qshift, range, counter);
+      }
+      x1 = y1[k];
+      x2 = y2[k];
       y2[k] = y1[k];
       y1[k] = y;
       x = y;
     }
     out[i] = x;
   }
-  for (int k = 0; k < N; ++k) state[k] = SectionState{x1[k], x2[k], y1[k], y2[k]};
+  state[0].x1 = in1;
+  state[0].x2 = in2;
+  state[0].y1 = y1[0];
+  state[0].y2 = y2[0];
+  for (int k = 1; k < N; ++k) state[k] = SectionState{y1[k - 1], y2[k - 1], y1[k], y2[k]};
 }
 
 // Any section count (more than the specialized ones): the same arithmetic from memory.
@@ -271,9 +301,18 @@ template <Rounding R, Overflow O, class SectionState>
 void bandpass_dispatch_sections(const std::int64_t* in, std::int64_t* out, std::size_t len, std::int64_t in_scale,
                                 const std::vector<std::vector<std::int64_t>>& coef,
                                 std::vector<SectionState>& state, int qshift, const FxRange& range,
-                                OverflowCounter& counter) {
-#define RANGING_BP_CASE(n) \
-  case n: return bandpass_kernel<n, R, O>(in, out, len, in_scale, coef, state, qshift, range, counter);
+                                OverflowCounter& counter, bool bias, bool sym) {
+#define RANGING_BP_CASE(n)                                                                         \
+  case n:                                                                                          \
+    if (bias && sym)                                                                               \
+      return bandpass_kernel<n, R, O, R == Rounding::RoundHalfUp, true>(in, out, len, in_scale, coef, state, \
+                                                                        qshift, range, counter);   \
+    if (bias)                                                                                      \
+      return bandpass_kernel<n, R, O, R == Rounding::RoundHalfUp, false>(in, out, len, in_scale, coef, state, \
+                                                                         qshift, range, counter);  \
+    if (sym)                                                                                       \
+      return bandpass_kernel<n, R, O, false, true>(in, out, len, in_scale, coef, state, qshift, range, counter); \
+    return bandpass_kernel<n, R, O, false, false>(in, out, len, in_scale, coef, state, qshift, range, counter);
   switch (coef.size()) {
     RANGING_BP_CASE(1)
     RANGING_BP_CASE(2)
@@ -312,7 +351,7 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
   const int qshift = config_.coef_frac;  // acc_frac - data_frac
   fx_dispatch(config_.rounding, config_.overflow, [&]<Rounding R, Overflow O>() {
     bandpass_dispatch_sections<R, O>(in.data(), out.data(), in.size(), in_scale, coef_, state_, qshift, data_range_,
-                                     section_events_);
+                                     section_events_, bias_ok_, sym_ok_);
   });
   for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
 }

@@ -126,6 +126,8 @@ class BandpassFixed final : public BandpassFilter {
   std::vector<State> state_;
   std::vector<std::int64_t> out_;
   FxRange data_range_{};
+  bool bias_ok_ = false;
+  bool sym_ok_ = false;   // every numerator is b0 [1, 0, -1]: one multiply (see .cpp)  // the RoundHalfUp kernel may fold its rounding constant (see .cpp)
   OverflowCounter section_events_, input_events_;
   [[noreturn]] void throw_input_range(std::int64_t x_in) const;
 };

@@ -199,58 +199,68 @@ CorrelatorBankFloat::CorrelatorBankFloat(const CorrelatorReference& ref)
 
 void CorrelatorBankFloat::reset() {
   n_ = 0;
+  dec_phase_ = 0;
   acc_re_ = acc_im_ = energy_ = 0;
   b_re_.assign(static_cast<std::size_t>(ref_.period), 0.0);
   b_im_.assign(b_re_.size(), 0.0);
   b_idx_ = 0;
-  bd_re_.assign(ref_.chip_taps.size(), 0.0);
-  bd_im_.assign(ref_.chip_taps.size(), 0.0);
-  f_re_.assign(combiner_history(ref_), 0.0);
-  f_im_.assign(f_re_.size(), 0.0);
+  lo_cos_.clear();
+  lo_sin_.clear();
+  for (int p = 0; p < ref_.period; ++p) {  // the same expression the per-sample form evaluated
+    const double w = 2.0 * std::numbers::pi * static_cast<double>(p) / ref_.period;
+    lo_cos_.push_back(std::cos(w));
+    lo_sin_.push_back(std::sin(w));
+  }
+  bd_n_ = ref_.chip_taps.size();
+  bd_re_.assign(2 * bd_n_, 0.0);
+  bd_im_.assign(2 * bd_n_, 0.0);
+  f_n_ = combiner_history(ref_);
+  f_re_.assign(2 * f_n_, 0.0);
+  f_im_.assign(2 * f_n_, 0.0);
   y2_.assign(static_cast<std::size_t>(ref_.window), 0.0);
-  bd_idx_ = bd_re_.size() - 1;
-  f_idx_ = f_re_.size() - 1;
+  bd_idx_ = bd_n_ - 1;
+  f_idx_ = f_n_ - 1;
   y_idx_ = y2_.size() - 1;
   q_.assign(ref_.codes.size(), 0.0);
 }
 
 bool CorrelatorBankFloat::execute(double y) {
-  const double w = 2.0 * std::numbers::pi * static_cast<double>(n_ % ref_.period) / ref_.period;
-  const double bre = y * std::cos(w), bim = -y * std::sin(w);
+  const double bre = y * lo_cos_[b_idx_], bim = -y * lo_sin_[b_idx_];
   acc_re_ += bre - b_re_[b_idx_];
   acc_im_ += bim - b_im_[b_idx_];
   b_re_[b_idx_] = bre;
   b_im_[b_idx_] = bim;
-  b_idx_ = (b_idx_ + 1) % b_re_.size();
-  y_idx_ = (y_idx_ + 1) % y2_.size();
+  if (++b_idx_ == b_re_.size()) b_idx_ = 0;
+  if (++y_idx_ == y2_.size()) y_idx_ = 0;
   energy_ += y * y - y2_[y_idx_];
   y2_[y_idx_] = y * y;
   energy_ = std::max(energy_, 0.0);  // running-sum rounding in double
   ++n_;
-  if (n_ % ref_.decimation != 0) return false;
+  if (++dec_phase_ != ref_.decimation) return false;
+  dec_phase_ = 0;
 
-  bd_idx_ = (bd_idx_ + 1) % bd_re_.size();
-  bd_re_[bd_idx_] = acc_re_;
-  bd_im_[bd_idx_] = acc_im_;
+  if (++bd_idx_ == bd_n_) bd_idx_ = 0;
+  bd_re_[bd_idx_] = bd_re_[bd_idx_ + bd_n_] = acc_re_;
+  bd_im_[bd_idx_] = bd_im_[bd_idx_ + bd_n_] = acc_im_;
   double fre = 0, fim = 0;
-  const std::size_t m = bd_re_.size();
+  const std::size_t m = bd_n_;
+  const double* bre_h = bd_re_.data() + bd_idx_ + m;  // Bd[k - i] = bre_h[-i]
+  const double* bim_h = bd_im_.data() + bd_idx_ + m;
   for (std::size_t i = 0; i < m; ++i) {
-    const std::size_t k = (bd_idx_ + m - i) % m;
-    fre += ref_.chip_taps[i] * bd_re_[k];
-    fim += ref_.chip_taps[i] * bd_im_[k];
+    fre += ref_.chip_taps[i] * bre_h[-static_cast<std::ptrdiff_t>(i)];
+    fim += ref_.chip_taps[i] * bim_h[-static_cast<std::ptrdiff_t>(i)];
   }
-  f_idx_ = (f_idx_ + 1) % f_re_.size();
-  f_re_[f_idx_] = fre;
-  f_im_[f_idx_] = fim;
+  if (++f_idx_ == f_n_) f_idx_ = 0;
+  f_re_[f_idx_] = f_re_[f_idx_ + f_n_] = fre;
+  f_im_[f_idx_] = f_im_[f_idx_ + f_n_] = fim;
   chip_mag_ = std::hypot(fre, fim);
   corr_mag_ = 0;
 
-  const std::size_t fn = f_re_.size();
   const std::size_t step = static_cast<std::size_t>(ref_.chip_samples / ref_.decimation);
   for (std::size_t j = 0; j < q_.size(); ++j) {
     double cre = 0, cim = 0;
     for (int c = 0; c < chips_; ++c) {
-      const std::size_t k = (f_idx_ + fn - static_cast<std::size_t>(chips_ - 1 - c) * step) % fn;
+      const std::size_t k = f_idx_ + f_n_ - static_cast<std::size_t>(chips_ - 1 - c) * step;
       const double s = ref_.codes[j][c] ? 1.0 : -1.0;
       cre += s * f_re_[k];
       cim += s * f_im_[k];

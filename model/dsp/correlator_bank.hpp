@@ -108,11 +108,15 @@ class CorrelatorBankFloat {
   std::int64_t n_ = 0;
   double acc_re_ = 0, acc_im_ = 0;             // moving sum of B over one carrier cycle
   std::vector<double> b_re_, b_im_;            // B history, P long
-  std::size_t b_idx_ = 0;
-  std::vector<double> bd_re_, bd_im_;          // Bd history, M long
-  std::vector<double> f_re_, f_im_;            // F history, (L-1) Nc/D + 1 long
+  std::size_t b_idx_ = 0;                      // = n mod P: also the LO phase
+  std::vector<double> lo_cos_, lo_sin_;        // cos / sin(2 pi p / P), p < P (as computed per sample)
+  // Bd (M) and F ((L-1) Nc/D + 1) histories, each ring stored twice (slots i and i + size):
+  // a window ending at the newest entry is contiguous, no modulo per tap.
+  std::vector<double> bd_re_, bd_im_;
+  std::vector<double> f_re_, f_im_;
   std::vector<double> y2_;                     // y^2 history, W long
-  std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0;
+  std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0, bd_n_ = 0, f_n_ = 0;
+  int dec_phase_ = 0;
   double energy_ = 0, chip_mag_ = 0, corr_mag_ = 0;
   std::vector<double> q_;
 };
