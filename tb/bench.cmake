@@ -9,4 +9,7 @@ target_compile_definitions(bench_receiver_top PRIVATE RANGING_CONFIG="${PROJECT_
 verilate(bench_receiver_top SOURCES ${RANGING_GEN_DEFAULT}/rtl/receiver_top.v
   ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v ${PROJECT_SOURCE_DIR}/rtl/correlator_bank.v
   ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v
-  TOP_MODULE receiver_top PREFIX Vreceiver_top VERILATOR_ARGS -Wno-fatal -O3)
+  TOP_MODULE receiver_top PREFIX Vreceiver_top
+  # Bench build only (the equivalence testbenches keep their settings): X values resolved once
+  # at compile time and initial values not randomized (scripts/bench.sh measures the choice).
+  VERILATOR_ARGS -Wno-fatal -O3 --x-assign fast --x-initial fast)

@@ -190,6 +190,11 @@ BandpassFixed::BandpassFixed(const SosFilter& filter, const BandpassFixedConfig&
   input_fmt_ = FixedFormat{config.input_bits, config.input_bits - 1, true, Rounding::RoundHalfUp, Overflow::Saturate};
   data_fmt_ = FixedFormat{config.data_bits, config.data_frac, true, config.rounding, config.overflow};
   input_shift_ = config.data_frac - (config.input_bits - 1);
+  data_range_ = fx_range(data_fmt_);
+  // The folded rounding bias needs |acc| < 2^61 (see bandpass_kernel) and a dropped bit.
+  bias_ok_ = min_acc_bits(config, coef_) <= 62 && config.coef_frac >= 1;
+  sym_ok_ = config.data_bits <= 62 && config.data_frac <= 61;
+  for (const auto& c : coef_) sym_ok_ = sym_ok_ && c[1] == 0 && c[2] == -c[0];
   reset();
 }
 
@@ -200,32 +205,162 @@ void BandpassFixed::reset() {
   input_events_ = {};
 }
 
+void BandpassFixed::throw_input_range(std::int64_t x_in) const {
+  std::ostringstream os;
+  os << "bandpass input sample: " << x_in << " is out of range; valid range is [" << fx_min_raw(input_fmt_)
+     << ", " << fx_max_raw(input_fmt_) << "] (signed " << config_.input_bits << "-bit)";
+  throw InputError(os.str());
+}
+
+namespace {
+
+
+// One block through N sections, sample-major, state in locals. Exact: every partial sum of the
+// accumulator is bounded by sum |b_i| max|x| + sum |a_i| max|y| < 2^(acc_min - 1), acc_min =
+// bandpass_min_acc_bits <= acc_bits <= 64 (validate()), so the int64 arithmetic never
+// overflows; the aligned input |x| <= 2^data_frac <= 2^62. Section k's input history is
+// section k-1's output history (x1[k] = y1[k-1], x2[k] = y2[k-1]), so only section 0 keeps
+// its own. The a1 y1 term is added last: it is the only one on the loop-carried path.
+// Bias (RoundHalfUp only, when acc_min <= 62): round half up of acc / 2^s is
+// floor((acc + 2^(s-1)) / 2^s), and the constant 2^(s-1) <= 2^61 is folded into the terms off
+// the critical path; |acc| + 2^(s-1) < 2^61 + 2^61 cannot overflow.
+// Sym (every section's numerator is b0 [1, 0, -1], as a Butterworth/Chebyshev bandpass's are,
+// and data_bits <= 62, data_frac <= 61 so every section input |x| < 2^61): b0 x + b2 x2 =
+// b0 (x - x2) exactly, |x - x2| < 2^62, one multiply instead of three.
+template <int N, Rounding R, Overflow O, bool Bias, bool Sym, class SectionState>
+void bandpass_kernel(const std::int64_t* in, std::int64_t* out, std::size_t len, std::int64_t in_scale,
+                     const std::vector<std::vector<std::int64_t>>& coef, std::vector<SectionState>& state,
+                     int qshift, const FxRange& range, OverflowCounter& counter) {
+  std::int64_t b0[N], b1[N], b2[N], a1[N], a2[N], y1[N], y2[N];
+  for (int k = 0; k < N; ++k) {
+    b0[k] = coef[k][0];
+    b1[k] = coef[k][1];
+    b2[k] = coef[k][2];
+    a1[k] = coef[k][3];
+    a2[k] = coef[k][4];
+    y1[k] = state[k].y1;
+    y2[k] = state[k].y2;
+  }
+  std::int64_t in1 = state[0].x1, in2 = state[0].x2;
+  const std::int64_t bias = Bias ? (std::int64_t{1} << (qshift - 1)) : 0;
+  for (std::size_t i = 0; i < len; ++i) {
+    std::int64_t x = in[i] * in_scale;
+    std::int64_t x1 = in1, x2 = in2;
+    in2 = in1;
+    in1 = x;
+    for (int k = 0; k < N; ++k) {
+      std::int64_t part;
+      if constexpr (Sym) {
+        part = b0[k] * (x - x2) - a2[k] * y2[k] + bias;
+      } else {
+        part = b0[k] * x + b1[k] * x1 + b2[k] * x2 - a2[k] * y2[k] + bias;
+      }
+      const std::int64_t acc = part - a1[k] * y1[k];
+      std::int64_t y;
+      if constexpr (Bias) {
+        y = acc >> qshift;
+        if (y < range.lo || y > range.hi) [[unlikely]] y = fx_overflow_slow(y, range, O, counter);
+      } else {
+        y = fx_quantize_fast<R, O>(acc, qshift, range, counter);
+      }
+      x1 = y1[k];
+      x2 = y2[k];
+      y2[k] = y1[k];
+      y1[k] = y;
+      x = y;
+    }
+    out[i] = x;
+  }
+  state[0].x1 = in1;
+  state[0].x2 = in2;
+  state[0].y1 = y1[0];
+  state[0].y2 = y2[0];
+  for (int k = 1; k < N; ++k) state[k] = SectionState{y1[k - 1], y2[k - 1], y1[k], y2[k]};
+}
+
+// Any section count (more than the specialized ones): the same arithmetic from memory.
+template <Rounding R, Overflow O, class SectionState>
+void bandpass_kernel_any(const std::int64_t* in, std::int64_t* out, std::size_t len, std::int64_t in_scale,
+                         const std::vector<std::vector<std::int64_t>>& coef, std::vector<SectionState>& state,
+                         int qshift, const FxRange& range, OverflowCounter& counter) {
+  for (std::size_t i = 0; i < len; ++i) {
+    std::int64_t x = in[i] * in_scale;
+    for (std::size_t k = 0; k < coef.size(); ++k) {
+      const std::int64_t* c = coef[k].data();
+      SectionState& s = state[k];
+      const std::int64_t part = c[0] * x + c[1] * s.x1 + c[2] * s.x2 - c[4] * s.y2;
+      const std::int64_t y = fx_quantize_fast<R, O>(part - c[3] * s.y1, qshift, range, counter);
+      s = SectionState{x, s.x1, y, s.y1};
+      x = y;
+    }
+    out[i] = x;
+  }
+}
+
+template <Rounding R, Overflow O, class SectionState>
+void bandpass_dispatch_sections(const std::int64_t* in, std::int64_t* out, std::size_t len, std::int64_t in_scale,
+                                const std::vector<std::vector<std::int64_t>>& coef,
+                                std::vector<SectionState>& state, int qshift, const FxRange& range,
+                                OverflowCounter& counter, bool bias, bool sym) {
+#define RANGING_BP_CASE(n)                                                                         \
+  case n:                                                                                          \
+    if (bias && sym)                                                                               \
+      return bandpass_kernel<n, R, O, R == Rounding::RoundHalfUp, true>(in, out, len, in_scale, coef, state, \
+                                                                        qshift, range, counter);   \
+    if (bias)                                                                                      \
+      return bandpass_kernel<n, R, O, R == Rounding::RoundHalfUp, false>(in, out, len, in_scale, coef, state, \
+                                                                         qshift, range, counter);  \
+    if (sym)                                                                                       \
+      return bandpass_kernel<n, R, O, false, true>(in, out, len, in_scale, coef, state, qshift, range, counter); \
+    return bandpass_kernel<n, R, O, false, false>(in, out, len, in_scale, coef, state, qshift, range, counter);
+  switch (coef.size()) {
+    RANGING_BP_CASE(1)
+    RANGING_BP_CASE(2)
+    RANGING_BP_CASE(3)
+    RANGING_BP_CASE(4)
+    RANGING_BP_CASE(5)
+    RANGING_BP_CASE(6)
+    RANGING_BP_CASE(7)
+    RANGING_BP_CASE(8)
+    default: return bandpass_kernel_any<R, O>(in, out, len, in_scale, coef, state, qshift, range, counter);
+  }
+#undef RANGING_BP_CASE
+}
+
+}  // namespace
+
+void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<std::int64_t> out) {
+  if (in.size() != out.size()) {
+    throw InputError("bandpass execute_block: output size " + std::to_string(out.size()) +
+                     " differs from input size " + std::to_string(in.size()) + "; they must be equal");
+  }
+  if (in.empty()) return;
+  // Range check once per block.
+  const std::int64_t lo = fx_min_raw(input_fmt_), hi = fx_max_raw(input_fmt_);
+  std::int64_t mn = in[0], mx = in[0];
+  for (const std::int64_t v : in) {
+    mn = std::min(mn, v);
+    mx = std::max(mx, v);
+  }
+  if (mn < lo || mx > hi) {
+    for (const std::int64_t v : in) {
+      if (v < lo || v > hi) throw_input_range(v);
+    }
+  }
+  const std::int64_t in_scale = std::int64_t{1} << input_shift_;
+  const int qshift = config_.coef_frac;  // acc_frac - data_frac
+  fx_dispatch(config_.rounding, config_.overflow, [&]<Rounding R, Overflow O>() {
+    bandpass_dispatch_sections<R, O>(in.data(), out.data(), in.size(), in_scale, coef_, state_, qshift, data_range_,
+                                     section_events_, bias_ok_, sym_ok_);
+  });
+  for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
+}
+
 std::int64_t BandpassFixed::execute_raw(std::int64_t x_in) {
-  if (x_in < fx_min_raw(input_fmt_) || x_in > fx_max_raw(input_fmt_)) {
-    std::ostringstream os;
-    os << "bandpass input sample: " << x_in << " is out of range; valid range is [" << fx_min_raw(input_fmt_)
-       << ", " << fx_max_raw(input_fmt_) << "] (signed " << config_.input_bits << "-bit)";
-    throw InputError(os.str());
-  }
-  // Aligning the input to data_frac is wiring (a multiply by 2^shift, never an overflow:
-  // |x| <= 2^data_frac <= 2^62).
-  std::int64_t x = x_in * (std::int64_t{1} << input_shift_);
-  const int acc_frac = accumulator_frac();
-  for (std::size_t k = 0; k < coef_.size(); ++k) {
-    const std::int64_t* c = coef_[k].data();
-    State& s = state_[k];
-    // Exact: validate() proved every partial sum fits acc_bits <= 64 bits.
-    std::int64_t acc = c[0] * x + c[2] * s.x2 - c[3] * s.y1 - c[4] * s.y2;
-    if (c[1] != 0) acc += c[1] * s.x1;  // zero b1 (g*[1,0,-1] numerators): no multiplier
-    const std::int64_t y = fx_quantize(acc, acc_frac, data_fmt_, &section_events_);
-    s.x2 = s.x1;
-    s.x1 = x;
-    s.y2 = s.y1;
-    s.y1 = y;
-    out_[k] = y;
-    x = y;
-  }
-  return x;
+  // A block of one: the testbenches check the very kernel the block API runs.
+  std::int64_t y = 0;
+  execute_block(std::span<const std::int64_t>(&x_in, 1), std::span<std::int64_t>(&y, 1));
+  return y;
 }
 
 double BandpassFixed::execute(double x) {

@@ -93,6 +93,15 @@ class BandpassFixed final : public BandpassFilter {
   // Input: signed input_bits integer (InputError if outside); output: signed data_bits
   // integer with data_frac fraction bits.
   std::int64_t execute_raw(std::int64_t x);
+  // Block form: out[i] = execute_raw(in[i]) for every i, bit for bit, with the same overflow
+  // counts and final state (section_outputs() holds the last sample's). The input range is
+  // checked once for the whole block: an out-of-range sample throws InputError before any
+  // sample is processed (the state is left as it was). Sizes must match (InputError).
+  // Kernel: sample-major with every section's state in registers (specialized per section
+  // count 1..8, rounding and overflow at compile time), so the out-of-order core overlaps
+  // the sections' recursions.
+  using BandpassFilter::execute_block;
+  void execute_block(std::span<const std::int64_t> in, std::span<std::int64_t> out);
 
   const std::vector<std::int64_t>& section_outputs() const { return out_; }  // last sample, per section
   const std::vector<std::vector<std::int64_t>>& coefficients() const { return coef_; }  // {b0,b1,b2,a1,a2}
@@ -116,7 +125,11 @@ class BandpassFixed final : public BandpassFilter {
   std::vector<std::vector<std::int64_t>> coef_;
   std::vector<State> state_;
   std::vector<std::int64_t> out_;
+  FxRange data_range_{};
+  bool bias_ok_ = false;
+  bool sym_ok_ = false;   // every numerator is b0 [1, 0, -1]: one multiply (see .cpp)  // the RoundHalfUp kernel may fold its rounding constant (see .cpp)
   OverflowCounter section_events_, input_events_;
+  [[noreturn]] void throw_input_range(std::int64_t x_in) const;
 };
 
 }  // namespace ranging

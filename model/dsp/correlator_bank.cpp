@@ -199,58 +199,68 @@ CorrelatorBankFloat::CorrelatorBankFloat(const CorrelatorReference& ref)
 
 void CorrelatorBankFloat::reset() {
   n_ = 0;
+  dec_phase_ = 0;
   acc_re_ = acc_im_ = energy_ = 0;
   b_re_.assign(static_cast<std::size_t>(ref_.period), 0.0);
   b_im_.assign(b_re_.size(), 0.0);
   b_idx_ = 0;
-  bd_re_.assign(ref_.chip_taps.size(), 0.0);
-  bd_im_.assign(ref_.chip_taps.size(), 0.0);
-  f_re_.assign(combiner_history(ref_), 0.0);
-  f_im_.assign(f_re_.size(), 0.0);
+  lo_cos_.clear();
+  lo_sin_.clear();
+  for (int p = 0; p < ref_.period; ++p) {  // the same expression the per-sample form evaluated
+    const double w = 2.0 * std::numbers::pi * static_cast<double>(p) / ref_.period;
+    lo_cos_.push_back(std::cos(w));
+    lo_sin_.push_back(std::sin(w));
+  }
+  bd_n_ = ref_.chip_taps.size();
+  bd_re_.assign(2 * bd_n_, 0.0);
+  bd_im_.assign(2 * bd_n_, 0.0);
+  f_n_ = combiner_history(ref_);
+  f_re_.assign(2 * f_n_, 0.0);
+  f_im_.assign(2 * f_n_, 0.0);
   y2_.assign(static_cast<std::size_t>(ref_.window), 0.0);
-  bd_idx_ = bd_re_.size() - 1;
-  f_idx_ = f_re_.size() - 1;
+  bd_idx_ = bd_n_ - 1;
+  f_idx_ = f_n_ - 1;
   y_idx_ = y2_.size() - 1;
   q_.assign(ref_.codes.size(), 0.0);
 }
 
 bool CorrelatorBankFloat::execute(double y) {
-  const double w = 2.0 * std::numbers::pi * static_cast<double>(n_ % ref_.period) / ref_.period;
-  const double bre = y * std::cos(w), bim = -y * std::sin(w);
+  const double bre = y * lo_cos_[b_idx_], bim = -y * lo_sin_[b_idx_];
   acc_re_ += bre - b_re_[b_idx_];
   acc_im_ += bim - b_im_[b_idx_];
   b_re_[b_idx_] = bre;
   b_im_[b_idx_] = bim;
-  b_idx_ = (b_idx_ + 1) % b_re_.size();
-  y_idx_ = (y_idx_ + 1) % y2_.size();
+  if (++b_idx_ == b_re_.size()) b_idx_ = 0;
+  if (++y_idx_ == y2_.size()) y_idx_ = 0;
   energy_ += y * y - y2_[y_idx_];
   y2_[y_idx_] = y * y;
   energy_ = std::max(energy_, 0.0);  // running-sum rounding in double
   ++n_;
-  if (n_ % ref_.decimation != 0) return false;
+  if (++dec_phase_ != ref_.decimation) return false;
+  dec_phase_ = 0;
 
-  bd_idx_ = (bd_idx_ + 1) % bd_re_.size();
-  bd_re_[bd_idx_] = acc_re_;
-  bd_im_[bd_idx_] = acc_im_;
+  if (++bd_idx_ == bd_n_) bd_idx_ = 0;
+  bd_re_[bd_idx_] = bd_re_[bd_idx_ + bd_n_] = acc_re_;
+  bd_im_[bd_idx_] = bd_im_[bd_idx_ + bd_n_] = acc_im_;
   double fre = 0, fim = 0;
-  const std::size_t m = bd_re_.size();
+  const std::size_t m = bd_n_;
+  const double* bre_h = bd_re_.data() + bd_idx_ + m;  // Bd[k - i] = bre_h[-i]
+  const double* bim_h = bd_im_.data() + bd_idx_ + m;
   for (std::size_t i = 0; i < m; ++i) {
-    const std::size_t k = (bd_idx_ + m - i) % m;
-    fre += ref_.chip_taps[i] * bd_re_[k];
-    fim += ref_.chip_taps[i] * bd_im_[k];
+    fre += ref_.chip_taps[i] * bre_h[-static_cast<std::ptrdiff_t>(i)];
+    fim += ref_.chip_taps[i] * bim_h[-static_cast<std::ptrdiff_t>(i)];
   }
-  f_idx_ = (f_idx_ + 1) % f_re_.size();
-  f_re_[f_idx_] = fre;
-  f_im_[f_idx_] = fim;
+  if (++f_idx_ == f_n_) f_idx_ = 0;
+  f_re_[f_idx_] = f_re_[f_idx_ + f_n_] = fre;
+  f_im_[f_idx_] = f_im_[f_idx_ + f_n_] = fim;
   chip_mag_ = std::hypot(fre, fim);
   corr_mag_ = 0;
 
-  const std::size_t fn = f_re_.size();
   const std::size_t step = static_cast<std::size_t>(ref_.chip_samples / ref_.decimation);
   for (std::size_t j = 0; j < q_.size(); ++j) {
     double cre = 0, cim = 0;
     for (int c = 0; c < chips_; ++c) {
-      const std::size_t k = (f_idx_ + fn - static_cast<std::size_t>(chips_ - 1 - c) * step) % fn;
+      const std::size_t k = f_idx_ + f_n_ - static_cast<std::size_t>(chips_ - 1 - c) * step;
       const double s = ref_.codes[j][c] ? 1.0 : -1.0;
       cre += s * f_re_[k];
       cim += s * f_im_[k];
@@ -270,6 +280,11 @@ CorrelatorBankFixed::CorrelatorBankFixed(const CorrelatorReference& ref,
   mix_fmt_ = FixedFormat{cfg.mix_bits, layout_.mix_frac, true, Rounding::RoundHalfUp, Overflow::Saturate};
   chip_fmt_ = FixedFormat{cfg.chip_bits, 0, true, Rounding::RoundHalfUp, Overflow::Saturate};
   corr_fmt_ = FixedFormat{cfg.corr_bits, 0, true, Rounding::RoundHalfUp, Overflow::Saturate};
+  mix_range_ = fx_range(mix_fmt_);
+  chip_range_ = fx_range(chip_fmt_);
+  corr_range_ = fx_range(corr_fmt_);
+  for (const auto& row : signs_) sign_flat_.insert(sign_flat_.end(), row.begin(), row.end());
+  taps_rev_.assign(layout_.taps_q.rbegin(), layout_.taps_q.rend());
   reset();
 }
 
@@ -277,17 +292,20 @@ void CorrelatorBankFixed::reset() {
   const auto& l = layout_;
   n_ = 0;
   phase_ = 0;
+  dec_phase_ = 0;
+  ready_ = false;
   mix_re_ = mix_im_ = acc_re_ = acc_im_ = 0;
   b_re_.assign(static_cast<std::size_t>(l.period), 0);
   b_im_.assign(b_re_.size(), 0);
-  b_idx_ = 0;
-  bd_re_.assign(l.taps, 0);
-  bd_im_.assign(l.taps, 0);
-  f_re_.assign(static_cast<std::size_t>(l.chips - 1) * (l.chip_samples / l.decimation) + 1, 0);
-  f_im_.assign(f_re_.size(), 0);
+  bd_n_ = static_cast<std::size_t>(l.taps);
+  bd_re_.assign(2 * bd_n_, 0);
+  bd_im_.assign(2 * bd_n_, 0);
+  f_n_ = static_cast<std::size_t>(l.chips - 1) * static_cast<std::size_t>(l.chip_samples / l.decimation) + 1;
+  f_re_.assign(2 * f_n_, 0);
+  f_im_.assign(2 * f_n_, 0);
   y2_.assign(static_cast<std::size_t>(l.window), 0);
-  bd_idx_ = bd_re_.size() - 1;
-  f_idx_ = f_re_.size() - 1;
+  bd_idx_ = bd_n_ - 1;
+  f_idx_ = f_n_ - 1;
   y_idx_ = y2_.size() - 1;
   energy_ = 0;
   corr_re_.assign(l.codes, 0);
@@ -298,58 +316,118 @@ void CorrelatorBankFixed::reset() {
 }
 
 bool CorrelatorBankFixed::execute(std::int64_t y) {
+  feed(std::span<const std::int64_t>(&y, 1));
+  return ready_;
+}
+
+std::size_t CorrelatorBankFixed::feed(std::span<const std::int64_t> in) {
+  using enum Rounding;
   const auto& l = layout_;
-  // 1. mixer: exact product, round half up into the mixer format.
-  const int product_frac = cfg_.data_frac + cfg_.lo_bits - 1;
-  mix_re_ = fx_quantize(static_cast<int128_t>(y) * l.lo_cos[phase_], product_frac, mix_fmt_, &counter_);
-  mix_im_ = fx_quantize(-static_cast<int128_t>(y) * l.lo_sin[phase_], product_frac, mix_fmt_, &counter_);
-  phase_ = (phase_ + 1) % l.period;
-  // 2. moving sum over one carrier cycle (exact; dec_bits hold it).
-  acc_re_ += mix_re_ - b_re_[b_idx_];
-  acc_im_ += mix_im_ - b_im_[b_idx_];
-  b_re_[b_idx_] = mix_re_;
-  b_im_[b_idx_] = mix_im_;
-  b_idx_ = (b_idx_ + 1) % b_re_.size();
-  // 7. energy: running sum of y^2 over the window, exact (unsigned, wraps never: width holds it).
-  y_idx_ = (y_idx_ + 1) % y2_.size();
-  const std::uint64_t y2 = static_cast<std::uint64_t>(y * y);
-  energy_ = energy_ + y2 - y2_[y_idx_];
-  y2_[y_idx_] = y2;
-  ++n_;
-  if (n_ % l.decimation != 0) return false;
-
-  // decimator output: every D-th moving sum.
-  bd_idx_ = (bd_idx_ + 1) % bd_re_.size();
-  bd_re_[bd_idx_] = acc_re_;
-  bd_im_[bd_idx_] = acc_im_;
-  // 3. chip filter: exact accumulation, then round half up by chip_shift (bound fits).
-  std::int64_t fre = 0, fim = 0;
-  const std::size_t m = bd_re_.size();
-  for (std::size_t i = 0; i < m; ++i) {
-    const std::size_t k = (bd_idx_ + m - i) % m;
-    fre += l.taps_q[i] * bd_re_[k];
-    fim += l.taps_q[i] * bd_im_[k];
-  }
-  f_idx_ = (f_idx_ + 1) % f_re_.size();
-  f_re_[f_idx_] = fx_quantize(fre, l.chip_shift, chip_fmt_, &counter_);
-  f_im_[f_idx_] = fx_quantize(fim, l.chip_shift, chip_fmt_, &counter_);
-
-  // 4-6. combiner (exact), quantize, power, weight.
-  const std::size_t fn = f_re_.size();
-  const std::size_t step = static_cast<std::size_t>(l.chip_samples / l.decimation);
-  for (std::size_t j = 0; j < signs_.size(); ++j) {
-    std::int64_t cre = 0, cim = 0;
-    for (int c = 0; c < l.chips; ++c) {
-      const std::size_t k = (f_idx_ + fn - static_cast<std::size_t>(l.chips - 1 - c) * step) % fn;
-      cre += signs_[j][c] * f_re_[k];
-      cim += signs_[j][c] * f_im_[k];
+  // Exact int64 bounds: |y| < 2^(data_bits-1) <= 2^31 and |lo| < 2^(lo_bits-1) <= 2^23, so
+  // |y lo| < 2^54; |acc| < 2^(dec_bits-1) <= 2^37; y^2 < 2^62 and E < 2^energy_bits <= 2^63
+  // (resolve_correlator_layout refuses wider), so E is exact in uint64.
+  const int mix_shift = l.mix_shift;
+  const std::int64_t* lo_cos = l.lo_cos.data();
+  const std::int64_t* lo_sin = l.lo_sin.data();
+  std::int64_t* b_re = b_re_.data();
+  std::int64_t* b_im = b_im_.data();
+  std::uint64_t* y2h = y2_.data();
+  const int period = l.period;
+  const std::size_t window = y2_.size();
+  int phase = phase_, dec_phase = dec_phase_;
+  std::size_t y_idx = y_idx_;
+  std::int64_t acc_re = acc_re_, acc_im = acc_im_, mre = mix_re_, mim = mix_im_;
+  std::uint64_t energy = energy_;
+  std::size_t i = 0;
+  ready_ = false;
+  while (i < in.size()) {
+    const std::int64_t y = in[i++];
+    // 1. mixer: exact product, round half up into the mixer format.
+    mre = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(y * lo_cos[phase], mix_shift, mix_range_, counter_);
+    mim = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(-y * lo_sin[phase], mix_shift, mix_range_, counter_);
+    // 2. moving sum over one carrier cycle (exact; dec_bits hold it).
+    acc_re += mre - b_re[phase];
+    acc_im += mim - b_im[phase];
+    b_re[phase] = mre;
+    b_im[phase] = mim;
+    if (++phase == period) phase = 0;
+    // 7. energy: running sum of y^2 over the window, exact.
+    if (++y_idx == window) y_idx = 0;
+    const std::uint64_t y2 = static_cast<std::uint64_t>(y * y);
+    energy = energy + y2 - y2h[y_idx];
+    y2h[y_idx] = y2;
+    if (++dec_phase == l.decimation) {
+      dec_phase = 0;
+      ready_ = true;
+      break;
     }
-    corr_re_[j] = fx_quantize(cre, l.corr_shift, corr_fmt_, &counter_);
-    corr_im_[j] = fx_quantize(cim, l.corr_shift, corr_fmt_, &counter_);
+  }
+  n_ += static_cast<std::int64_t>(i);
+  phase_ = phase;
+  dec_phase_ = dec_phase;
+  y_idx_ = y_idx;
+  acc_re_ = acc_re;
+  acc_im_ = acc_im;
+  mix_re_ = mre;
+  mix_im_ = mim;
+  energy_ = energy;
+  if (ready_) decimated_output();
+  return i;
+}
+
+void CorrelatorBankFixed::decimated_output() {
+  using enum Rounding;
+  const auto& l = layout_;
+  // decimator output: every D-th moving sum, written to both copies of the ring.
+  if (++bd_idx_ == bd_n_) bd_idx_ = 0;
+  bd_re_[bd_idx_] = bd_re_[bd_idx_ + bd_n_] = acc_re_;
+  bd_im_[bd_idx_] = bd_im_[bd_idx_ + bd_n_] = acc_im_;
+  // 3. chip filter: exact accumulation (fir_bits <= 62), then round half up by chip_shift.
+  // The window Bd[k], Bd[k-1], ..., Bd[k-M+1] is slots bd_idx_ + M, ..., bd_idx_ + 1.
+  std::int64_t fre = 0, fim = 0;
+  const std::int64_t* bre = bd_re_.data() + bd_idx_ + 1;
+  const std::int64_t* bim = bd_im_.data() + bd_idx_ + 1;
+  const std::int64_t* taps = taps_rev_.data();
+  for (std::size_t i = 0; i < bd_n_; ++i) {
+    fre += taps[i] * bre[i];
+    fim += taps[i] * bim[i];
+  }
+  if (++f_idx_ == f_n_) f_idx_ = 0;
+  const std::int64_t fq_re = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(fre, l.chip_shift, chip_range_, counter_);
+  const std::int64_t fq_im = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(fim, l.chip_shift, chip_range_, counter_);
+  f_re_[f_idx_] = f_re_[f_idx_ + f_n_] = fq_re;
+  f_im_[f_idx_] = f_im_[f_idx_ + f_n_] = fq_im;
+
+  // 4-6. combiner (exact, comb_bits), quantize, power, weight. Chip c of every code reads
+  // F[k - (L-1-c) Nc/D], slot f_idx_ + f_n_ - (L-1-c) step of the doubled ring.
+  const std::size_t step = static_cast<std::size_t>(l.chip_samples / l.decimation);
+  const std::size_t chips = static_cast<std::size_t>(l.chips);
+  std::int64_t g_re[64], g_im[64];
+  std::vector<std::int64_t> g_heap;
+  std::int64_t* gr = g_re;
+  std::int64_t* gi = g_im;
+  if (chips > 64) {
+    g_heap.resize(2 * chips);
+    gr = g_heap.data();
+    gi = g_heap.data() + chips;
+  }
+  for (std::size_t c = 0; c < chips; ++c) {
+    const std::size_t k = f_idx_ + f_n_ - (chips - 1 - c) * step;
+    gr[c] = f_re_[k];
+    gi[c] = f_im_[k];
+  }
+  const std::int64_t* sg = sign_flat_.data();
+  for (std::size_t j = 0; j < q_.size(); ++j, sg += chips) {
+    std::int64_t cre = 0, cim = 0;
+    for (std::size_t c = 0; c < chips; ++c) {
+      cre += sg[c] * gr[c];
+      cim += sg[c] * gi[c];
+    }
+    corr_re_[j] = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(cre, l.corr_shift, corr_range_, counter_);
+    corr_im_[j] = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(cim, l.corr_shift, corr_range_, counter_);
     p_[j] = static_cast<std::uint64_t>(corr_re_[j] * corr_re_[j] + corr_im_[j] * corr_im_[j]);
     q_[j] = p_[j] * static_cast<std::uint64_t>(l.weights[j]);
   }
-  return true;
 }
 
 }  // namespace ranging

@@ -108,11 +108,15 @@ class CorrelatorBankFloat {
   std::int64_t n_ = 0;
   double acc_re_ = 0, acc_im_ = 0;             // moving sum of B over one carrier cycle
   std::vector<double> b_re_, b_im_;            // B history, P long
-  std::size_t b_idx_ = 0;
-  std::vector<double> bd_re_, bd_im_;          // Bd history, M long
-  std::vector<double> f_re_, f_im_;            // F history, (L-1) Nc/D + 1 long
+  std::size_t b_idx_ = 0;                      // = n mod P: also the LO phase
+  std::vector<double> lo_cos_, lo_sin_;        // cos / sin(2 pi p / P), p < P (as computed per sample)
+  // Bd (M) and F ((L-1) Nc/D + 1) histories, each ring stored twice (slots i and i + size):
+  // a window ending at the newest entry is contiguous, no modulo per tap.
+  std::vector<double> bd_re_, bd_im_;
+  std::vector<double> f_re_, f_im_;
   std::vector<double> y2_;                     // y^2 history, W long
-  std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0;
+  std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0, bd_n_ = 0, f_n_ = 0;
+  int dec_phase_ = 0;
   double energy_ = 0, chip_mag_ = 0, corr_mag_ = 0;
   std::vector<double> q_;
 };
@@ -124,6 +128,13 @@ class CorrelatorBankFixed {
   void reset();
   // Feeds one filtered sample (signed data_bits integer). Returns true on a decimated output.
   bool execute(std::int64_t y);
+  // Block form: feeds y[0], y[1], ... up to and including the first sample that completes a
+  // decimated output, or to the end of y; returns how many were consumed. output_ready() then
+  // says whether the last one consumed produced an output (the state every accessor below
+  // reads is then that output's). Bit for bit the same as execute() on each sample; execute()
+  // is a feed of one. Ranges are not checked (the bandpass output is in range by construction).
+  std::size_t feed(std::span<const std::int64_t> y);
+  bool output_ready() const { return ready_; }
 
   // Stage taps of the last decimated output, for stage-by-stage comparison with the hardware.
   std::int64_t mix_re() const { return mix_re_; }  // last full-rate mixer output
@@ -152,13 +163,21 @@ class CorrelatorBankFixed {
   CorrelatorFixedConfig cfg_;
   CorrelatorFixedLayout layout_;
   std::vector<std::vector<int>> signs_;
+  std::vector<std::int64_t> sign_flat_;     // signs_ row-major, codes x chips
+  std::vector<std::int64_t> taps_rev_;      // taps_q reversed: the FIR reads forward
   FixedFormat mix_fmt_, chip_fmt_, corr_fmt_;
+  FxRange mix_range_, chip_range_, corr_range_;
   std::int64_t n_ = 0;
-  int phase_ = 0;
+  int phase_ = 0;      // LO phase = index into b_ (they advance together), wraps by compare
+  int dec_phase_ = 0;  // samples since the last decimated output
+  bool ready_ = false;
+  void decimated_output();
   std::int64_t mix_re_ = 0, mix_im_ = 0, acc_re_ = 0, acc_im_ = 0;
-  std::vector<std::int64_t> b_re_, b_im_;  // B history, P long
-  std::size_t b_idx_ = 0;
+  std::vector<std::int64_t> b_re_, b_im_;  // B history, P long (slot phase_)
+  // Bd (M taps) and F ((L-1) Nc/D + 1) histories as rings stored twice (slot i and i + size)
+  // so that a window ending at the newest entry is contiguous: no modulo in the loops.
   std::vector<std::int64_t> bd_re_, bd_im_, f_re_, f_im_;
+  std::size_t bd_n_ = 0, f_n_ = 0;  // ring sizes (half the vectors)
   std::vector<std::uint64_t> y2_;
   std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0;
   std::uint64_t energy_ = 0;

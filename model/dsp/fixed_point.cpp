@@ -132,6 +132,25 @@ std::int64_t fx_quantize(int128_t raw, int src_frac, const FixedFormat& fmt, Ove
   return wrap_bits(bits, fmt);
 }
 
+FxRange fx_range(const FixedFormat& fmt) {
+  return FxRange{fx_min_raw(fmt), fx_max_raw(fmt), fmt.width, fmt.is_signed};
+}
+
+std::int64_t fx_overflow_slow(std::int64_t q, const FxRange& r, Overflow o, OverflowCounter& counter) {
+  if (o == Overflow::Saturate) {
+    ++counter.saturations;
+    return q < r.lo ? r.lo : r.hi;
+  }
+  ++counter.wraps;
+  std::uint64_t low = static_cast<std::uint64_t>(q);
+  if (r.width < 64) {
+    const std::uint64_t mask = (std::uint64_t{1} << r.width) - 1;
+    low &= mask;
+    if (r.is_signed && ((low >> (r.width - 1)) & 1)) low |= ~mask;  // sign extension
+  }
+  return static_cast<std::int64_t>(low);
+}
+
 double FixedWide::to_double() const { return std::ldexp(static_cast<double>(raw), -frac); }
 
 Fixed::Fixed(double value, const FixedFormat& fmt, OverflowCounter* counter) : fmt_(fmt) {

@@ -60,6 +60,65 @@ struct OverflowCounter {
 // The format is not validated here (hot path); validate it once beforehand.
 std::int64_t fx_quantize(int128_t raw, int src_frac, const FixedFormat& fmt, OverflowCounter* counter);
 
+// ---- Hot-loop quantizer ---------------------------------------------------------------------
+// fx_quantize specialized at compile time for the model's inner loops: the rounding rule R and
+// the overflow rule O are template parameters, the source is an int64 and the shift is
+// 0 <= shift <= 62 (bits dropped, src_frac - fmt.frac). Every stage that calls it proves its
+// int64 bound where it does (bandpass: acc_bits <= 64 by validate(); correlator: the layout's
+// widths are <= 62 bits). Same result and the same overflow count as fx_quantize for those
+// arguments (tests/test_block_api.cpp compares the two on every mode).
+struct FxRange {  // a format's range, resolved once
+  std::int64_t lo = 0, hi = 0;
+  int width = 2;
+  bool is_signed = true;
+};
+FxRange fx_range(const FixedFormat& fmt);
+
+// floor(raw / 2^shift) adjusted by R (shift = 0: raw). No overflow: |q| <= 2^(63 - shift).
+template <Rounding R>
+inline std::int64_t fx_round_shift(std::int64_t raw, int shift) {
+  if (shift == 0) return raw;
+  const std::int64_t q = raw >> shift;  // arithmetic shift (C++20): floor
+  if constexpr (R == Rounding::Truncate) {
+    return q;
+  } else if constexpr (R == Rounding::RoundHalfUp) {
+    return q + ((raw >> (shift - 1)) & 1);  // the first dropped bit: remainder >= half
+  } else {
+    const std::uint64_t rem = static_cast<std::uint64_t>(raw) & ((std::uint64_t{1} << shift) - 1);
+    const std::uint64_t half = std::uint64_t{1} << (shift - 1);
+    return q + static_cast<std::int64_t>(rem > half || (rem == half && (q & 1)));  // ties to even
+  }
+}
+
+// The out-of-range branch: saturate or wrap into r, counted (never inlined: it is rare).
+std::int64_t fx_overflow_slow(std::int64_t q, const FxRange& r, Overflow o, OverflowCounter& counter);
+
+template <Rounding R, Overflow O>
+inline std::int64_t fx_quantize_fast(std::int64_t raw, int shift, const FxRange& r, OverflowCounter& counter) {
+  const std::int64_t q = fx_round_shift<R>(raw, shift);
+  if (q < r.lo || q > r.hi) [[unlikely]] return fx_overflow_slow(q, r, O, counter);
+  return q;
+}
+
+// Calls f.template operator()<R, O>() with the format's rules as compile-time constants: the
+// one run-time switch per block instead of per sample.
+template <class F>
+decltype(auto) fx_dispatch(Rounding rounding, Overflow overflow, F&& f) {
+  const bool sat = overflow == Overflow::Saturate;
+  switch (rounding) {
+    case Rounding::Truncate:
+      return sat ? f.template operator()<Rounding::Truncate, Overflow::Saturate>()
+                 : f.template operator()<Rounding::Truncate, Overflow::Wrap>();
+    case Rounding::RoundHalfUp:
+      return sat ? f.template operator()<Rounding::RoundHalfUp, Overflow::Saturate>()
+                 : f.template operator()<Rounding::RoundHalfUp, Overflow::Wrap>();
+    case Rounding::Convergent:
+    default:
+      return sat ? f.template operator()<Rounding::Convergent, Overflow::Saturate>()
+                 : f.template operator()<Rounding::Convergent, Overflow::Wrap>();
+  }
+}
+
 // An exact intermediate result (up to 128 bits): what +, -, * of Fixed values give.
 // It has no rounding/overflow rule of its own; fixed_cast applies the target's.
 struct FixedWide {

@@ -246,6 +246,27 @@ std::optional<EventFixed> ReceiverFixed::execute_raw(std::int64_t x) {
   return detector_.execute(bank_);
 }
 
+std::size_t ReceiverFixed::execute_block(std::span<const std::int64_t> x, std::vector<EventFixed>& events) {
+  constexpr std::size_t kChunk = 1024;
+  const std::size_t before = events.size();
+  chunk_.resize(kChunk);
+  while (!x.empty()) {
+    const std::size_t n = std::min(kChunk, x.size());
+    const std::span<std::int64_t> y(chunk_.data(), n);
+    filter_.execute_block(x.first(n), y);
+    std::span<const std::int64_t> rest(y);
+    while (!rest.empty()) {
+      rest = rest.subspan(bank_.feed(rest));
+      if (bank_.output_ready()) {
+        if (auto e = detector_.execute(bank_)) events.push_back(*e);
+      }
+    }
+    filtered_ = y[n - 1];
+    x = x.subspan(n);
+  }
+  return events.size() - before;
+}
+
 Event ReceiverFixed::to_float(const EventFixed& e) const { return e.to_float(frac_bits_, score_bits_); }
 
 std::optional<Event> ReceiverFixed::execute(double x) {

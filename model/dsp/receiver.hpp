@@ -6,6 +6,7 @@
 // Both are built from one ReceiverConfig (configs/*.yaml), the single source of truth.
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,11 @@ class ReceiverFixed {
   void reset();
   // x: signed input_bits ADC code.
   std::optional<EventFixed> execute_raw(std::int64_t x);
+  // Block form: the same as execute_raw on every x[i] in order, bit for bit (events, state,
+  // overflow counts); events are appended to `events` (returns how many). The filter runs a
+  // chunk at a time (range checked once per chunk: an out-of-range code throws InputError
+  // before its chunk is processed), then the bank and the detector.
+  std::size_t execute_block(std::span<const std::int64_t> x, std::vector<EventFixed>& events);
   // x in full-scale units: quantized by quantize_input first; the event in float form.
   std::optional<Event> execute(double x);
   std::optional<EventFixed> flush_raw() { return detector_.flush(); }
@@ -119,6 +125,7 @@ class ReceiverFixed {
   PeakDetectorFixed detector_;
   std::int64_t filtered_ = 0;
   OverflowCounter input_counter_;
+  std::vector<std::int64_t> chunk_;  // execute_block's filtered chunk
 };
 
 }  // namespace ranging

@@ -1,0 +1,160 @@
+// The golden model stage by stage (Google Benchmark; timing lives here, never in tests), on the
+// default configuration (configs/default.yaml) and the paper's schedule: every code of the
+// family once per 1400 samples, received at 0.5 m with noise (as tb/bench_receiver_top).
+//   Fixed/Bandpass   BandpassFixed::execute_block (5 sections)
+//   Fixed/Bank       CorrelatorBankFixed::feed on the filtered signal
+//   Fixed/Receiver   ReceiverFixed::execute_block: bandpass + bank + detector
+//   Float/...        the same stages of the double-precision reference, per sample
+// The detector's share is Receiver - Bandpass - Bank. items_per_second = samples/s.
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#include "model/config/receiver_config.hpp"
+#include "model/dsp/excitation.hpp"
+#include "model/dsp/receiver.hpp"
+#include "model/sim/channel.hpp"
+
+int sc_main(int, char**) { return 0; }  // the bench programs link libsystemc, which references it
+
+namespace {
+
+using namespace ranging;
+
+struct Setup {
+  ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
+  std::vector<double> x;           // full-scale units
+  std::vector<std::int64_t> codes; // ADC codes
+  std::vector<std::int64_t> filtered;
+  std::vector<double> filtered_float;
+  Setup() {
+    ExcitationParams ex;
+    const int period = 1400, eta = d.family.eta();
+    const std::size_t n = 7353 + static_cast<std::size_t>(eta * period) + 3000;
+    x.assign(n, 0.0);
+    for (int j = 0; j < eta; ++j) {
+      ChannelParams ch;
+      ch.distance_m = 0.5;
+      ch.gain = 0.5;
+      ch.noise_rms = 0.002;
+      ch.seed = static_cast<std::uint64_t>(j + 1);
+      const auto rx = propagate(bpsk_excitation(d.family.codes[j], ex), ch, d.config.fs,
+                                n - static_cast<std::size_t>(j * period));
+      for (std::size_t k = 0; k < rx.size(); ++k) x[k + static_cast<std::size_t>(j * period)] += rx[k];
+    }
+    for (double v : x) codes.push_back(quantize_input(v, d.config.bandpass.input_bits, nullptr));
+    BandpassFixed bp(d.filter, d.config.bandpass);
+    filtered.resize(codes.size());
+    bp.execute_block(codes, filtered);
+    BandpassFloat bf(d.filter);
+    for (double v : x) filtered_float.push_back(bf.execute(v));
+  }
+};
+
+const Setup& setup() {
+  static const Setup s;
+  return s;
+}
+
+void items(benchmark::State& state) {
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(setup().x.size()));
+}
+
+void BM_FixedBandpass(benchmark::State& state) {
+  const Setup& s = setup();
+  BandpassFixed bp(s.d.filter, s.d.config.bandpass);
+  std::vector<std::int64_t> out(s.codes.size());
+  for (auto _ : state) {
+    bp.reset();
+    bp.execute_block(s.codes, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  items(state);
+}
+
+void BM_FixedBank(benchmark::State& state) {
+  const Setup& s = setup();
+  CorrelatorBankFixed bank(s.d.reference, s.d.config.correlator);
+  for (auto _ : state) {
+    bank.reset();
+    std::span<const std::int64_t> rest(s.filtered);
+    std::uint64_t outputs = 0;
+    while (!rest.empty()) {
+      rest = rest.subspan(bank.feed(rest));
+      outputs += bank.output_ready();
+    }
+    benchmark::DoNotOptimize(outputs);
+  }
+  items(state);
+}
+
+void BM_FixedReceiver(benchmark::State& state) {
+  const Setup& s = setup();
+  ReceiverFixed rx(s.d);
+  std::vector<EventFixed> ev;
+  for (auto _ : state) {
+    rx.reset();
+    ev.clear();
+    rx.execute_block(s.codes, ev);
+    benchmark::DoNotOptimize(ev.data());
+  }
+  items(state);
+}
+
+void BM_FixedReceiverPerSample(benchmark::State& state) {
+  const Setup& s = setup();
+  ReceiverFixed rx(s.d);
+  for (auto _ : state) {
+    rx.reset();
+    std::size_t n = 0;
+    for (auto v : s.codes) n += rx.execute_raw(v).has_value();
+    benchmark::DoNotOptimize(n);
+  }
+  items(state);
+}
+
+void BM_FloatBandpass(benchmark::State& state) {
+  const Setup& s = setup();
+  BandpassFloat bp(s.d.filter);
+  std::vector<double> out(s.x.size());
+  for (auto _ : state) {
+    bp.reset();
+    bp.execute_block(s.x, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  items(state);
+}
+
+void BM_FloatBank(benchmark::State& state) {
+  const Setup& s = setup();
+  CorrelatorBankFloat bank(s.d.reference);
+  for (auto _ : state) {
+    bank.reset();
+    std::size_t n = 0;
+    for (double v : s.filtered_float) n += bank.execute(v);
+    benchmark::DoNotOptimize(n);
+  }
+  items(state);
+}
+
+void BM_FloatReceiver(benchmark::State& state) {
+  const Setup& s = setup();
+  ReceiverFloat rx(s.d);
+  for (auto _ : state) {
+    rx.reset();
+    std::size_t n = 0;
+    for (double v : s.x) n += rx.execute(v).has_value();
+    benchmark::DoNotOptimize(n);
+  }
+  items(state);
+}
+
+BENCHMARK(BM_FixedBandpass)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FixedBank)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FixedReceiver)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FixedReceiverPerSample)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FloatBandpass)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FloatBank)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FloatReceiver)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
