@@ -5,6 +5,8 @@
 #include "model/base/error.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
+#include "model/hw/ip_package.hpp"
+#include "tool/build_info.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 
@@ -12,11 +14,14 @@ namespace ranging::tool {
 
 int cmd_generate(const Args& args) {
   cli::Parser p("ranging generate",
-                "Generate the HLS C++ configuration and the Verilog of the receiver described by a\n"
-                "configuration file. The output folder is replaced atomically: on error nothing is\n"
-                "written.");
+                "Generate the self-contained IP folder of the receiver described by a configuration\n"
+                "file: the Verilog top and parameters, copies of every RTL source it needs, the HLS\n"
+                "C++ and its configuration header, filelists (files.f: receiver_top, system.f: the\n"
+                "ranging system), a README of the ports, a FuseSoC CAPI2 .core file and a GTKWave\n"
+                "save file. The output folder is replaced atomically: on error nothing is written.");
   p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md)");
   p.option("--out", "DIR", "output folder");
+  p.option("--rtl", "DIR", "take the RTL sources from DIR instead of the project's rtl/");
   p.option("--origin", "NAME", "name of the configuration in the generated banners (default: FILE as given)");
   if (!p.parse(args)) return 0;
   const auto config = p.get("--config");
@@ -26,7 +31,9 @@ int cmd_generate(const Args& args) {
   const ReceiverConfig cfg = load_receiver_config(*config);
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);
-  const auto files = generate_hardware_files(design, p.get_or("--origin", *config));
+  auto files = generate_hardware_files(design, p.get_or("--origin", *config));
+  add_ip_package(files, design, p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl"),
+                 std::string(build_info::kSourceDir) + "/hls", build_info::kVersion);
   write_hardware_files(files, *out);
   std::cout << "generated " << files.size() << " files for configuration '" << design.config.name
             << "' in " << *out << "\n";
