@@ -30,6 +30,8 @@ constexpr Subcommand kSubcommands[] = {
     {"evaluate", "reproduce the paper's Section 4 evaluation (Tables 4-6, Figures 13-15)",
      ranging::tool::cmd_evaluate},
     {"decode", "decode a recorded capture (oscilloscope CSV or WAV)", ranging::tool::cmd_decode},
+    {"verify", "verify the RTL of a configuration against the golden model, stage by stage",
+     ranging::tool::cmd_verify},
 };
 
 void print_usage(std::ostream& os) {
