@@ -123,3 +123,29 @@ TEST(Verify, BadInputExits2WithNothingOnStdout) {
     EXPECT_NE(r.err.find(c.key), std::string::npos) << c.args << ": " << r.err;
   }
 }
+
+// A scene through the Verilated receiver: its events equal the fixed model's, so the
+// measurements are exactly those of --precision fixed.
+TEST(SimulateRtl, SceneEventsThroughTheRtlEqualTheFixedModels) {
+  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
+  const auto fixed = run_tool("simulate " + scene + " --precision fixed --quiet --out " + (scratch() / "fixed").string());
+  ASSERT_EQ(fixed.status, 0) << fixed.err;
+  const auto r = run_tool("simulate " + scene + " --precision rtl --json --quiet --out " + (scratch() / "rtl").string());
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["precision"], "rtl");
+  EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
+  EXPECT_EQ(j["rtl"]["mismatches"], 0);
+  EXPECT_GT(j["rtl"]["streams"].get<int>(), 0);
+  EXPECT_GE(j["rtl"]["events_compared"].get<int>(), j["rtl"]["streams"].get<int>());
+  auto read = [](const fs::path& p) {
+    std::stringstream ss;
+    ss << std::ifstream(p).rdbuf();
+    return ss.str();
+  };
+  EXPECT_EQ(read(scratch() / "rtl/measurements.csv"), read(scratch() / "fixed/measurements.csv"));
+  const auto bad = run_tool("simulate " + scene + " --precision float --rtl " + (kRoot / "rtl").string() + " --out " +
+                            (scratch() / "bad").string());
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--rtl"), std::string::npos) << bad.err;
+}

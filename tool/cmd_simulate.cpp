@@ -18,6 +18,7 @@
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/rtl_scene_check.hpp"
 #include "tool/scene_run.hpp"
 
 namespace ranging::tool {
@@ -150,7 +151,11 @@ int cmd_simulate(const Args& args) {
                 "codes over its distances and decode them. Writes DIR/measurements.csv (one row per\n"
                 "measurement) and DIR/summary.json; prints the stages built and a summary.");
   p.positional("SCENE", "scene file (YAML)");
-  p.option("--precision", "float|fixed", "receiver precision (overrides the scene's receiver.precision)");
+  p.option("--precision", "float|fixed|rtl",
+           "receiver precision (overrides the scene's receiver.precision); rtl: the fixed model, and every\n"
+           "stream also through the Verilated receiver (built at run time), whose events must be identical");
+  p.flag("--check-rtl", "the same as --precision rtl");
+  p.option("--rtl", "DIR", "with --precision rtl: the RTL sources (default: the project's rtl/)");
   p.option("--out", "DIR", "output directory (created); default out/<scene name>");
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
@@ -159,14 +164,24 @@ int cmd_simulate(const Args& args) {
   Scene scene = load_scene(p.positionals().at(0));
   if (p.has("--precision")) {
     const std::string prec = *p.get("--precision");
-    if (prec != "float" && prec != "fixed") {
-      throw InputError("option --precision: '" + prec + "' is not valid; valid: float, fixed");
+    if (prec != "float" && prec != "fixed" && prec != "rtl") {
+      throw InputError("option --precision: '" + prec + "' is not valid; valid: float, fixed, rtl");
     }
     scene.receiver.precision = prec;
   }
+  const bool rtl = p.has("--check-rtl") || scene.receiver.precision == "rtl";
+  if (p.has("--check-rtl") && p.has("--precision") && scene.receiver.precision != "rtl" &&
+      scene.receiver.precision != "fixed") {
+    throw InputError("option --check-rtl: the RTL is checked against the fixed model; not valid with --precision " +
+                     scene.receiver.precision);
+  }
+  if (p.has("--rtl") && !rtl) throw InputError("option --rtl: only with --precision rtl or --check-rtl");
+  if (rtl) scene.receiver.precision = "fixed";
   const std::string out = p.get_or("--out", "out/" + scene.name);
   const bool json = p.has("--json");
   SceneSimulator sim(scene);
+  RtlSceneCheck rtl_check(p.get_or("--rtl", ""), "", p.has("--quiet"));
+  if (rtl) rtl_check.attach(sim);
   if (!json) std::cout << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim) << std::flush;
 
   namespace fs = std::filesystem;
@@ -187,7 +202,11 @@ int cmd_simulate(const Args& args) {
     fs::remove_all(staging, ec);
     throw;
   }
-  const nlohmann::json summary = summary_json(sim, run);
+  nlohmann::json summary = summary_json(sim, run);
+  if (rtl) {
+    summary["precision"] = "rtl";
+    summary["rtl"] = rtl_check.run();
+  }
   write_file_atomic(out + "/measurements.csv", measurements_csv(run, scene.speed()));
   write_file_atomic(out + "/summary.json", summary.dump(2) + "\n");
   if (p.has("--write-captures")) {
@@ -204,10 +223,17 @@ int cmd_simulate(const Args& args) {
       std::printf("%-8s %4d %6zu %7zu %10.4f %8.4f %11.4g %9.1f %9.0f\n", f.family.c_str(), f.eta, f.measurements,
                   f.decode_errors, f.rmse_m * 1e3, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz);
     }
+    if (rtl) {
+      const auto& r = summary["rtl"];
+      std::cout << "\nRTL (Verilated receiver_top): " << r["streams"] << " streams, " << r["events_compared"]
+                << " events compared with the fixed model, " << r["mismatches"] << " mismatches"
+                << (r["pass"].get<bool>() ? ": identical\n" : "\n");
+      if (!r["first_mismatch"].is_null()) std::cout << "first mismatch: " << r["first_mismatch"].dump() << "\n";
+    }
     std::printf("\nwrote %s/measurements.csv, %s/summary.json%s\n", out.c_str(), out.c_str(),
                 p.has("--write-captures") ? (", " + out + "/captures/").c_str() : "");
   }
-  return 0;
+  return (rtl && !summary["rtl"]["pass"].get<bool>()) ? 1 : 0;
 }
 
 }  // namespace ranging::tool
