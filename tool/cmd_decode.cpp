@@ -16,6 +16,7 @@
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
 
 namespace ranging::tool {
 
@@ -99,7 +100,7 @@ int cmd_decode(const Args& args) {
                                  {"rho", d.rho_max}, {"u", d.u}, {"pearson_code", d.pearson_code},
                                  {"receiver_rho2", d.score}});
     }
-    std::cout << j.dump(2) << "\n";
+    std::cout << stamp_build_info(j).dump(2) << "\n";
   } else {
     std::printf("%s: %zu samples at %.6g MS/s, family %s, c = %.2f m/s\n", path.c_str(), cap.samples.size(),
                 cap.sample_rate / 1e6, family.c_str(), c);

@@ -19,6 +19,7 @@
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
 #include "tool/scene_run.hpp"
 
 namespace ranging::tool {
@@ -57,14 +58,14 @@ int cmd_evaluate(const Args& args) {
                 "(T_d-max), Table 6 (v_max), Figures 13-15 (PNG via scripts/plot_section4.py) and a\n"
                 "generated Markdown document comparing the paper's values with ours.");
   p.positional("SCENE", "scene file, e.g. scenes/paper-section4.yaml");
-  p.option("--out", "DIR", "output directory", "docs/results");
+  p.option("--out", "DIR", "output directory (default: out/<scene name>; the committed results: --out docs/results)");
   p.flag("--no-plots", "skip the PNG figures (no Python needed)");
   p.flag("--json", "print the tables as JSON on stdout");
   p.flag("--quiet", "no progress bar");
   if (!p.parse(args)) return 0;
   const std::string scene_path = p.positionals().at(0);
   Scene scene = load_scene(scene_path);
-  const std::string out = p.get_or("--out", "docs/results");
+  const std::string out = p.get_or("--out", "out/" + scene.name);
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(out, ec);
@@ -236,7 +237,7 @@ int cmd_evaluate(const Args& args) {
     j["families"] = tables;
     j["checks"] = {{"vmax_equals_table6", vmax_ok}, {"td_within_10_percent", td_ok}, {"m_energy_above_gold", energy_ok}};
     j["document"] = stem + ".md";
-    std::cout << j.dump(2) << "\n";
+    std::cout << stamp_build_info(j).dump(2) << "\n";
   } else {
     std::cout << md.str();
   }

@@ -14,6 +14,7 @@
 #include "model/dsp/quantize.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -134,7 +135,7 @@ int cmd_filter(const Args& args) {
     j["gain"] = gain;
     j["quantized"] = {{"bits", bits}, {"frac", frac}, {"columns", {"b0", "b1", "b2", "a1", "a2"}},
                       {"sections", q}};
-    std::cout << j.dump() << "\n";
+    std::cout << stamp_build_info(j).dump() << "\n";
     return 0;
   }
 

@@ -18,6 +18,7 @@
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
 #include "tool/rtl_scene_check.hpp"
 #include "tool/scene_run.hpp"
 
@@ -108,6 +109,7 @@ std::string measurements_csv(const SceneRun& run, double /*c*/) {
 nlohmann::json summary_json(const SceneSimulator& sim, const SceneRun& run) {
   const Scene& s = sim.scene();
   nlohmann::json j;
+  stamp_build_info(j);
   j["scene"] = s.name;
   j["file"] = s.origin;
   j["precision"] = s.receiver.precision;
