@@ -15,6 +15,7 @@ int cmd_generate(const Args& args);  // HLS C++ and Verilog from a configuration
 int cmd_simulate(const Args& args);  // run a scene (cmd_simulate.cpp)
 int cmd_evaluate(const Args& args);  // reproduce the paper's Section 4 (cmd_evaluate.cpp)
 int cmd_decode(const Args& args);    // decode a real capture (cmd_decode.cpp)
+int cmd_frames(const Args& args);    // decode the board's UART frames (cmd_frames.cpp)
 int cmd_verify(const Args& args);    // the RTL of a configuration against the model (cmd_verify.cpp)
 
 }  // namespace ranging::tool

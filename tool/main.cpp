@@ -31,6 +31,8 @@ constexpr Subcommand kSubcommands[] = {
     {"evaluate", "reproduce the paper's Section 4 evaluation (Tables 4-6, Figures 13-15)",
      ranging::tool::cmd_evaluate},
     {"decode", "decode a recorded capture (oscilloscope CSV or WAV)", ranging::tool::cmd_decode},
+    {"frames", "decode the board's UART measurement frames (checksum, resync, bad-frame count)",
+     ranging::tool::cmd_frames},
     {"verify", "verify the RTL of a configuration against the golden model, stage by stage",
      ranging::tool::cmd_verify},
 };
