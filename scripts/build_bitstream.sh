@@ -11,7 +11,7 @@ config="$root/configs/default.yaml"
 large="$root/configs/large.yaml"
 build="$root/build"
 out=""
-results="$root/docs/results"
+results=""
 check=0
 others=1
 breakdown=0
@@ -34,7 +34,8 @@ Options:
   --build-dir DIR   CMake build folder holding tool/ranging (default: build)
   --out DIR         work folder for generated files, netlists, logs and the .bin
                     (default: BUILD/bitstream)
-  --results DIR     where the summary goes (default: docs/results)
+  --results DIR     where the summary goes (default: OUT/results; the committed summary:
+                    --results docs/results, as the `bitstream` build target does)
   --no-others       skip the ECP5 and Xilinx estimates
   --breakdown       also synthesize without flattening and list the iCE40 resources per module
   --seeds N         place and route with nextpnr seeds 1..N and keep the fastest (default 1;
@@ -67,6 +68,7 @@ done
 
 [[ -f "$config" ]] || die "--config: no file $config"
 out=${out:-"$build/bitstream"}
+results=${results:-"$out/results"}
 for t in yosys nextpnr-ice40 icepack icetime; do
   command -v "$t" >/dev/null || die "$t not found on PATH (scripts/install-deps.sh installs the FPGA tools)"
 done

@@ -61,6 +61,7 @@ endif()
 # build tree and fails unless the targets of docs/bitstream.md are met.
 add_custom_target(bitstream
   COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR} --breakdown --seeds 5
+          --results ${PROJECT_SOURCE_DIR}/docs/results
   DEPENDS ranging
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
   USES_TERMINAL)

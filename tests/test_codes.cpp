@@ -470,7 +470,12 @@ TEST(Cli, FamilyJsonIsExactlyTheContract) {
   const ToolRun r = run_tool("codes --family Gold4 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out.rfind("{\"family\":", 0), 0U) << r.out;  // key order as in the contract
-  const nlohmann::json j = nlohmann::json::parse(r.out);
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  // Every JSON output carries the tool's version and git commit (issue 16); the rest is exact.
+  ASSERT_TRUE(j.contains("version") && j.contains("git_commit")) << r.out;
+  EXPECT_FALSE(j["version"].get<std::string>().empty());
+  j.erase("version");
+  j.erase("git_commit");
   const ranging::CodeFamily f = ranging::code_family("Gold4");
   nlohmann::json codes = nlohmann::json::array();
   for (const Code& c : f.codes) {

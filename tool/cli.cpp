@@ -69,7 +69,7 @@ bool Parser::parse(const std::vector<std::string>& args) {
       }
       const Opt* o = find(name);
       if (o == nullptr) {
-        throw InputError(usage_ + ": unknown option '" + name + "' (see --help)");
+        throw InputError("unknown option '" + name + "' (see --help)");
       }
       if (o->name == "--help") {
         std::cout << help_text();
@@ -78,12 +78,12 @@ bool Parser::parse(const std::vector<std::string>& args) {
       if (o->takes_value) {
         if (!inline_value) {
           if (i + 1 >= args.size()) {
-            throw InputError(usage_ + ": option " + name + " needs a value " + o->metavar);
+            throw InputError("option " + name + " needs a value " + o->metavar);
           }
           value = args[++i];
         }
       } else if (inline_value) {
-        throw InputError(usage_ + ": option " + name + " takes no value");
+        throw InputError("option " + name + " takes no value");
       }
       given_.emplace_back(name, value);
     } else {
@@ -93,10 +93,10 @@ bool Parser::parse(const std::vector<std::string>& args) {
   size_t required = 0;
   for (const Pos& p : pos_) required += p.required ? 1 : 0;
   if (positionals_.size() < required) {
-    throw InputError(usage_ + ": missing argument " + pos_[positionals_.size()].metavar);
+    throw InputError("missing argument " + pos_[positionals_.size()].metavar);
   }
   if (positionals_.size() > pos_.size()) {
-    throw InputError(usage_ + ": unexpected argument '" + positionals_[pos_.size()] + "'");
+    throw InputError("unexpected argument '" + positionals_[pos_.size()] + "'");
   }
   return true;
 }

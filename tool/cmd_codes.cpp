@@ -11,6 +11,7 @@
 #include "model/base/error.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -49,7 +50,18 @@ std::uint32_t parse_poly(const std::string& text) {
   return value;
 }
 
-int list_families() {
+int list_families(bool json) {
+  if (json) {
+    nlohmann::ordered_json out;
+    out["families"] = nlohmann::ordered_json::array();
+    for (const std::string& name : code_family_names()) {
+      const CodeFamily f = code_family(name);
+      out["families"].push_back({{"name", name}, {"length", f.length}, {"eta", f.eta()},
+                                 {"description", code_family_description(name)}});
+    }
+    std::cout << stamp_build_info(out).dump() << "\n";
+    return 0;
+  }
   for (const std::string& name : code_family_names()) {
     const CodeFamily f = code_family(name);
     std::cout << std::left << std::setw(8) << name << std::right << " length " << std::setw(4)
@@ -69,8 +81,8 @@ int print_family(const std::string& name, bool json) {
   if (json) {
     nlohmann::ordered_json codes = nlohmann::ordered_json::array();
     for (const Code& c : f.codes) codes.push_back(chips_json(c));
-    const nlohmann::ordered_json out = {{"family", f.name}, {"length", f.length}, {"codes", codes}};
-    std::cout << out.dump() << "\n";
+    nlohmann::ordered_json out = {{"family", f.name}, {"length", f.length}, {"codes", codes}};
+    std::cout << stamp_build_info(out).dump() << "\n";
     return 0;
   }
   std::cout << "# " << f.name << ": " << f.eta() << " codes of " << f.length << " chips; "
@@ -86,11 +98,11 @@ int print_family(const std::string& name, bool json) {
 int print_msequence(int degree, std::uint32_t poly, bool json) {
   const Code c = msequence(degree, poly);
   if (json) {
-    const nlohmann::ordered_json out = {{"degree", degree},
+    nlohmann::ordered_json out = {{"degree", degree},
                                 {"poly", poly},
                                 {"length", c.size()},
                                 {"chips", chips_json(c)}};
-    std::cout << out.dump() << "\n";
+    std::cout << stamp_build_info(out).dump() << "\n";
     return 0;
   }
   std::cout << "# m-sequence degree " << degree << ", " << polynomial_string(poly) << " (" << hex_string(poly)
@@ -110,7 +122,7 @@ int cmd_codes(const Args& args) {
   p.option("--family", "NAME", "print every code of a family, e.g. M1 or Gold4");
   p.option("--degree", "N", "print one m-sequence of this degree (2..16)");
   p.option("--poly", "0xHEX", "feedback polynomial for --degree (default: the table's primitive one)");
-  p.flag("--json", "machine-readable output (with --family or --degree)");
+  p.flag("--json", "machine-readable output");
   if (!p.parse(args)) return 0;
   if (!p.positionals().empty()) {
     throw InputError("unexpected argument '" + p.positionals().front() +
@@ -127,8 +139,7 @@ int cmd_codes(const Args& args) {
   }
   const bool json = p.has("--json");
   if (p.has("--list")) {
-    if (json) throw InputError("--json: valid with --family or --degree, not with --list");
-    return list_families();
+    return list_families(json);
   }
   if (p.has("--family")) return print_family(*p.get("--family"), json);
 

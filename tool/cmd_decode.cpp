@@ -21,6 +21,7 @@
 #include "tool/cli.hpp"
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
 
 namespace ranging::tool {
 
@@ -200,7 +201,7 @@ int cmd_decode(const Args& args) {
     j["below_gate"] = nlohmann::json::array();
     for (const auto& d : below) j["below_gate"].push_back(det_json(d));
     j["found"] = !dets.empty();
-    std::cout << j.dump(2) << "\n";
+    std::cout << stamp_build_info(j).dump(2) << "\n";
   } else {
     std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s\n",
                  family.c_str(), family_source.c_str(), c.value, c.source.c_str(), period.value,

@@ -13,6 +13,7 @@
 #include "tool/cli.hpp"
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -104,7 +105,7 @@ int cmd_demo(const Args& args) {
                              {"rho_submax", r.rho_submax}, {"u", r.u}, {"energy", r.energy},
                              {"fixed_overflows", r.overflows}});
     }
-    std::cout << out.dump(2) << "\n";
+    std::cout << stamp_build_info(out).dump(2) << "\n";
   } else {
     std::printf("family %s, c = %.1f m/s, noise rms %.4g FS; ToF calibrated at 0.1 m\n\n",
                 d.receiver.family.c_str(), d.speed_of_sound, d.noise_rms);

@@ -22,6 +22,7 @@
 #include "tool/cli.hpp"
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
 #include "tool/scene_run.hpp"
 
 namespace ranging::tool {
@@ -168,7 +169,7 @@ int cmd_evaluate(const Args& args) {
                 "(T_d-max), Table 6 (v_max), Figures 13-15 (PNG via scripts/plot_section4.py) and a\n"
                 "generated Markdown document comparing the paper's values with ours.");
   p.positional("SCENE", "scene file, e.g. scenes/paper-section4.yaml");
-  p.option("--out", "DIR", "output directory", "docs/results");
+  p.option("--out", "DIR", "output directory (default: out/<scene name>; the committed results: --out docs/results)");
   p.flag("--no-plots", "skip the PNG figures (no Python needed)");
   p.flag("--json", "print the tables as JSON on stdout");
   p.option("--set", "KEY=VALUE", "override a key of the scene, a dotted YAML path (repeatable): noise.noise_v=0.01; receiver.config.KEY sets a key of its receiver configuration, e.g. receiver.config.correlator_fixed.chip_bits=18");
@@ -179,7 +180,7 @@ int cmd_evaluate(const Args& args) {
   const Overrides overrides = parse_overrides(p.values("--set"));
   Scene scene = load_scene(scene_path, overrides, p.has("--allow-out-of-spec"));
   warn_if_out_of_spec("evaluate", scene.receiver.config);
-  const std::string out = p.get_or("--out", "docs/results");
+  const std::string out = p.get_or("--out", "out/" + scene.name);
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(out, ec);
@@ -510,7 +511,7 @@ int cmd_evaluate(const Args& args) {
                    {"m15_energy_above_gold", energy15_ok},
                    {"td_clipped", td_clipped_total}};
     j["document"] = stem + ".md";
-    std::cout << j.dump(2) << "\n";
+    std::cout << stamp_build_info(j).dump(2) << "\n";
   } else {
     std::cout << md.str();
   }

@@ -23,6 +23,7 @@
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 #include "tool/guard.hpp"
+#include "tool/json_meta.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -210,7 +211,7 @@ int cmd_filter(const Args& args) {
     j["quantized"] = {{"bits", bits}, {"frac", frac}, {"columns", {"b0", "b1", "b2", "a1", "a2"}},
                       {"sections", q}, {"pole_radius", qradius}};
     j["guard"] = guard_json(guard, filter.order);
-    std::cout << j.dump() << "\n";
+    std::cout << stamp_build_info(j).dump() << "\n";
     return 0;
   }
 

@@ -5,6 +5,8 @@
 #include "model/base/error.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
+#include "model/hw/ip_package.hpp"
+#include "tool/build_info.hpp"
 #include "tool/cli.hpp"
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
@@ -13,11 +15,14 @@ namespace ranging::tool {
 
 int cmd_generate(const Args& args) {
   cli::Parser p("ranging generate",
-                "Generate the HLS C++ configuration and the Verilog of the receiver described by a\n"
-                "configuration file. The output folder is replaced atomically: on error nothing is\n"
-                "written.");
+                "Generate the self-contained IP folder of the receiver described by a configuration\n"
+                "file: the Verilog top and parameters, copies of every RTL source it needs, the HLS\n"
+                "C++ and its configuration header, filelists (files.f: receiver_top, system.f: the\n"
+                "ranging system), a README of the ports, a FuseSoC CAPI2 .core file and a GTKWave\n"
+                "save file. The output folder is replaced atomically: on error nothing is written.");
   p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md)");
   p.option("--out", "DIR", "output folder");
+  p.option("--rtl", "DIR", "take the RTL sources from DIR instead of the project's rtl/");
   p.option("--origin", "NAME", "name of the configuration in the generated banners (default: FILE as given)");
   p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): correlator_fixed.chip_bits=18, filter.type=ellip; the effective configuration is written as DIR/config.yaml");
   p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
@@ -32,6 +37,8 @@ int cmd_generate(const Args& args) {
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);
   auto files = generate_hardware_files(design, p.get_or("--origin", *config));
+  add_ip_package(files, design, p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl"),
+                 std::string(build_info::kSourceDir) + "/hls", build_info::kVersion);
   if (!overrides.empty()) files["config.yaml"] = receiver_config_yaml(cfg);  // re-run: --config DIR/config.yaml
   write_hardware_files(files, *out);
   std::cout << "generated " << files.size() << " files for configuration '" << design.config.name

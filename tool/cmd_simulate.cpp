@@ -20,6 +20,8 @@
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/rotor_run.hpp"
+#include "tool/json_meta.hpp"
+#include "tool/rtl_scene_check.hpp"
 #include "tool/scene_run.hpp"
 
 namespace ranging::tool {
@@ -121,6 +123,7 @@ std::string measurements_csv(const SceneRun& run, double /*c*/) {
 nlohmann::json summary_json(const SceneSimulator& sim, const SceneRun& run) {
   const Scene& s = sim.scene();
   nlohmann::json j;
+  stamp_build_info(j);
   j["scene"] = s.name;
   j["file"] = s.origin;
   j["precision"] = s.receiver.precision;
@@ -176,7 +179,11 @@ int cmd_simulate(const Args& args) {
                 "receiver configuration DIR/config.yaml: `ranging simulate DIR/scene.yaml` repeats the\n"
                 "run); prints the stages built and a summary.");
   p.positional("SCENE", "scene file (YAML)");
-  p.option("--precision", "float|fixed", "receiver precision (overrides the scene's receiver.precision)");
+  p.option("--precision", "float|fixed|rtl",
+           "receiver precision (overrides the scene's receiver.precision); rtl: the fixed model, and every\n"
+           "stream also through the Verilated receiver (built at run time), whose events must be identical");
+  p.flag("--check-rtl", "the same as --precision rtl");
+  p.option("--rtl", "DIR", "with --precision rtl: the RTL sources (default: the project's rtl/)");
   p.option("--out", "DIR", "output directory (created); default out/<scene name>");
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
@@ -188,17 +195,27 @@ int cmd_simulate(const Args& args) {
   warn_if_out_of_spec("simulate", scene.receiver.config);
   if (p.has("--precision")) {
     const std::string prec = *p.get("--precision");
-    if (prec != "float" && prec != "fixed") {
-      throw InputError("option --precision: '" + prec + "' is not valid; valid: float, fixed");
+    if (prec != "float" && prec != "fixed" && prec != "rtl") {
+      throw InputError("option --precision: '" + prec + "' is not valid; valid: float, fixed, rtl");
     }
     scene.receiver.precision = prec;
   }
+  const bool rtl = p.has("--check-rtl") || scene.receiver.precision == "rtl";
+  if (p.has("--check-rtl") && p.has("--precision") && scene.receiver.precision != "rtl" &&
+      scene.receiver.precision != "fixed") {
+    throw InputError("option --check-rtl: the RTL is checked against the fixed model; not valid with --precision " +
+                     scene.receiver.precision);
+  }
+  if (p.has("--rtl") && !rtl) throw InputError("option --rtl: only with --precision rtl or --check-rtl");
+  if (rtl) scene.receiver.precision = "fixed";
   const std::string out = p.get_or("--out", "out/" + scene.name);
   const bool json = p.has("--json");
   if (scene.geometry.type == "rotor" && p.has("--write-captures")) {
     throw InputError("option --write-captures: not available for rotor scenes");
   }
   SceneSimulator sim(scene);
+  RtlSceneCheck rtl_check(p.get_or("--rtl", ""), "", p.has("--quiet"));
+  if (rtl) rtl_check.attach(sim);
   if (!json) std::cout << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim) << std::flush;
 
   namespace fs = std::filesystem;
@@ -223,6 +240,10 @@ int cmd_simulate(const Args& args) {
   nlohmann::json summary = summary_json(sim, run);
   // The guard's verdict on the receiver's quantized filter (refused at load unless allowed).
   summary["design_guard"] = guard_json(check_quantized_design(scene.receiver.config), scene.receiver.config.filter_order);
+  if (rtl) {
+    summary["precision"] = "rtl";
+    summary["rtl"] = rtl_check.run();
+  }
   write_file_atomic(out + "/measurements.csv", measurements_csv(run, scene.speed()));
   write_file_atomic(out + "/summary.json", summary.dump(2) + "\n");
   write_effective_scene(scene, out);  // DIR/scene.yaml (+ config.yaml): re-run with `simulate DIR/scene.yaml`
@@ -247,10 +268,18 @@ int cmd_simulate(const Args& args) {
                 "rho^2 detector and its smallest per-code mean margin; prs.err / u_min: the paper's Pearson\n"
                 "matched filter (+-L chips) and eq. 10's u; Td_clip / Td_noise: T_d measurements the search\n"
                 "range clipped / whose threshold the noise floor set (docs/signal-model.md)\n");
+    if (rtl) {
+      const auto& r = summary["rtl"];
+      std::cout << "\nRTL (Verilated receiver_top): " << r["streams"] << " streams, " << r["events_compared"]
+                << " events compared with the fixed model, " << r["mismatches"] << " mismatches"
+                << (r["pass"].get<bool>() ? ": identical\n" : "\n");
+      if (!r["first_mismatch"].is_null()) std::cout << "first mismatch: " << r["first_mismatch"].dump() << "\n";
+    }
+    std::fflush(stdout);
     std::printf("\nwrote %s/measurements.csv, %s/summary.json, %s/scene.yaml%s\n", out.c_str(), out.c_str(), out.c_str(),
                 p.has("--write-captures") ? (", " + out + "/captures/").c_str() : "");
   }
-  return 0;
+  return (rtl && !summary["rtl"]["pass"].get<bool>()) ? 1 : 0;
 }
 
 }  // namespace ranging::tool

@@ -19,5 +19,7 @@ int cmd_doppler(const Args& args);   // decode rate and ToF bias vs line-of-sigh
 int cmd_sweep(const Args& args);     // design-space sweep and merge (cmd_sweep.cpp)
 int cmd_wordlength(const Args& args);  // word-length optimization (cmd_wordlength.cpp)
 int cmd_stability(const Args& args); // numerical stability report (cmd_stability.cpp)
+int cmd_frames(const Args& args);    // decode the board's UART frames (cmd_frames.cpp)
+int cmd_verify(const Args& args);    // the RTL of a configuration against the model (cmd_verify.cpp)
 
 }  // namespace ranging::tool

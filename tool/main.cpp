@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "model/base/error.hpp"
+#include "tool/build_info.hpp"
 #include "tool/commands.hpp"
 
 namespace {
@@ -35,10 +36,14 @@ constexpr Subcommand kSubcommands[] = {
     {"wordlength", "smallest fixed-point widths within an accuracy tolerance (docs/design-space.md)", ranging::tool::cmd_wordlength},
     {"stability", "numerical stability report: guard, headroom, limit cycles, filter structures",
      ranging::tool::cmd_stability},
+    {"frames", "decode the board's UART measurement frames (checksum, resync, bad-frame count)",
+     ranging::tool::cmd_frames},
+    {"verify", "verify the RTL of a configuration against the golden model, stage by stage",
+     ranging::tool::cmd_verify},
 };
 
 void print_usage(std::ostream& os) {
-  os << "usage: ranging <command> [options]    (ranging <command> --help for details)\n\n"
+  os << "usage: ranging <command> [options]    (ranging help <command> for details; ranging --version)\n\n"
         "Coded ultrasonic ranging co-design toolkit (Lu et al., Micromachines 2025, 16, 240).\n\n"
         "commands:\n";
   for (const Subcommand& c : kSubcommands) {
@@ -54,7 +59,18 @@ int main(int argc, char** argv) {
     print_usage(std::cerr);
     return 2;
   }
-  if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+  if (args[0] == "--version" || args[0] == "-V") {
+    std::cout << "ranging " << ranging::tool::build_info::kVersion << " (git " << ranging::tool::build_info::kGitCommit
+              << ")\n";
+    return 0;
+  }
+  if (args[0] == "help" && args.size() == 2) {
+    args = {args[1], "--help"};  // ranging help CMD: CMD --help
+  } else if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    if (args.size() > 2) {
+      std::cerr << "ranging help: give one command (ranging help CMD)\n";
+      return 2;
+    }
     print_usage(std::cout);
     return 0;
   }

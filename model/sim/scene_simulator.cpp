@@ -134,6 +134,7 @@ std::vector<SceneStage> scene_stages(const Scene& s) {
 
 struct SceneSimulator::Link {
   const Scene* scene = nullptr;
+  const FixedStreamObserver* observer = nullptr;
   std::string family_name;
   ReceiverDesign design;
   int L = 0, spc = 0;
@@ -225,13 +226,26 @@ struct SceneSimulator::Link {
     } else {
       ReceiverFixed rx(design);
       BandpassFloat bp(design.filter);
+      const bool observed = observer && *observer;
+      std::vector<std::int64_t> raw;
+      std::vector<EventFixed> raw_events;
+      OverflowCounter adc;
       for (std::size_t n = 0; n < volts.size(); ++n) {
         const double x = std::clamp(volts[n] * inv, -1.0, 1.0);
-        if (auto e = rx.execute(x)) ev.push_back(*e);
+        if (observed) {  // the same quantization as ReceiverFixed::execute(double)
+          raw.push_back(quantize_input(x, design.config.bandpass.input_bits, &adc));
+          if (auto e = rx.execute_raw(raw.back())) {
+            raw_events.push_back(*e);
+            ev.push_back(rx.to_float(*e));
+          }
+        } else if (auto e = rx.execute(x)) {
+          ev.push_back(*e);
+        }
         filtered[n] = bp.execute(volts[n]);
       }
       if (auto e = rx.flush()) ev.push_back(*e);
-      overflows += rx.overflow_events().total();
+      if (observed) (*observer)(design, raw, raw_events);
+      overflows += rx.overflow_events().total() + adc.total();  // adc: input saturations when observed
     }
     return ev;
   }
@@ -416,6 +430,7 @@ SceneSimulator::Link& SceneSimulator::link(const std::string& family) {
   }
   auto l = std::make_unique<Link>();
   l->scene = &scene_;
+  l->observer = &observer_;
   l->family_name = family;
   ReceiverConfig cfg = scene_.receiver.config;
   cfg.family = family;

@@ -139,6 +139,14 @@ class SceneSimulator {
   // the start of transmission, volts.
   std::vector<double> filtered_burst(const std::string& family, int code, double distance_m);
 
+  // Fixed precision only: called with every stream the fixed receiver runs (calibration and
+  // measurements), its quantized ADC input and the events execute_raw emitted, in order (the
+  // end-of-stream flush is not included). `ranging simulate --precision rtl` runs the same
+  // streams through the Verilated receiver and compares the events.
+  using FixedStreamObserver = std::function<void(const ReceiverDesign&, const std::vector<std::int64_t>&,
+                                                 const std::vector<EventFixed>&)>;
+  void set_fixed_observer(FixedStreamObserver f) { observer_ = std::move(f); }
+
   struct Link;  // per-family design, calibration and templates (scene_simulator.cpp)
 
  private:
@@ -146,6 +154,7 @@ class SceneSimulator {
   Scene scene_;
   std::vector<SceneStage> stages_;
   std::vector<std::unique_ptr<Link>> links_;
+  FixedStreamObserver observer_;
 };
 
 FamilySummary summarize(const Scene& scene, const std::string& family,

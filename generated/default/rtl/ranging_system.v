@@ -1,0 +1,171 @@
+////////////////////////////////////////////////////////////////////////////////
+//
+// Filename:  rtl/ranging_system.v
+//
+// Project:   ranging -- coded ultrasonic ranging system
+//
+// Purpose:   The whole ranging system around the generated receiver
+//            (docs/bitstream.md):
+//
+//              adc_interface --s_axis--> receiver_top --events--> tof_distance
+//                   | tick                                           ^   |
+//                   v                                  burst (code,  |   v
+//              tx_scheduler --> H-bridge (hb_p, hb_n)  start time) --+  measurement_uart --> uart_tx
+//
+//            One full-rate sample per CLK_DIV clocks (fs = f_clk / CLK_DIV);
+//            the transmitter and the receiver share that sample count, so an
+//            event's arrival (receiver sample index) and the bursts' start
+//            times are on one time base. The configuration-dependent
+//            parameters come from the generated rtl/ranging_system_top.v
+//            (model/hw/hw_system.cpp).
+//
+// Status:    led_meas: stretched pulse (LED_HOLD clocks) per measurement sent;
+//            led_error: sticky ADC overrun (the receiver did not keep up with
+//            fs: the time base is lost until reset).
+//
+////////////////////////////////////////////////////////////////////////////////
+`default_nettype none
+/* verilator lint_off WIDTH */
+
+module ranging_system #(
+  parameter integer CLK_DIV = 9,
+  parameter integer ADC_W = 12,
+  parameter integer ADC_OFFSET_BINARY = 1,
+  parameter integer CODES = 9,
+  parameter integer CHIPS = 7,
+  parameter integer SPC = 100,
+  parameter integer CYC = 4,
+  parameter integer PERIOD_T = 1634,
+  parameter [CODES*CHIPS-1:0] CODE_BITS = 0,
+  parameter integer CODE_W = 4,
+  parameter integer TIME_W = 40,
+  parameter integer FRAC_W = 8,
+  parameter integer SCORE_W = 16,
+  parameter integer OFF_W = 32,
+  parameter [CODES*OFF_W-1:0] OFFSETS = 0,
+  parameter integer C_FRAC = 16,
+  parameter [31:0] C_INIT = 32'd4456448,
+  parameter integer BAUD_DIV = 30,
+  parameter integer LED_HOLD = 2250000
+) (
+  input  wire clk, rst,
+  // ADC
+  output wire adc_clk,
+  input  wire [ADC_W-1:0] adc_data,
+  // transmitter H-bridge
+  output wire hb_p, hb_n,
+  output wire tx_active,
+  // measured speed of sound (compensation module): C format of tof_distance
+  input  wire c_wr,
+  input  wire [31:0] c_value,
+  // UART and status
+  output wire uart_tx,
+  output reg  led_meas,
+  output wire led_error,
+  // observation (testbench)
+  output wire sample_tick,
+  output wire meas_valid
+);
+  localparam integer ARR_W = TIME_W + FRAC_W + 1;
+  localparam integer EVENT_W = CODE_W + ARR_W + 2 * SCORE_W;
+
+  wire tick;
+  wire signed [ADC_W-1:0] sample;
+  wire sample_valid, sample_ready;
+  wire [15:0] overruns;
+
+  adc_interface #(.CLK_DIV(CLK_DIV), .ADC_W(ADC_W), .ADC_OFFSET_BINARY(ADC_OFFSET_BINARY)) u_adc (
+    .clk(clk), .rst(rst), .adc_clk(adc_clk), .adc_data(adc_data), .tick(tick),
+    .m_data(sample), .m_valid(sample_valid), .m_ready(sample_ready),
+    .overrun(led_error), .overruns(overruns)
+  );
+
+  wire burst_valid;
+  wire [CODE_W-1:0] burst_code;
+  wire [TIME_W-1:0] burst_time;
+  tx_scheduler #(.CODES(CODES), .CHIPS(CHIPS), .SPC(SPC), .CYC(CYC), .PERIOD_T(PERIOD_T),
+                 .CODE_W(CODE_W), .TIME_W(TIME_W), .CODE_BITS(CODE_BITS)) u_tx (
+    .clk(clk), .rst(rst), .tick(tick), .enable(1'b1),
+    .hb_p(hb_p), .hb_n(hb_n), .tx_active(tx_active),
+    .burst_valid(burst_valid), .burst_code(burst_code), .burst_time(burst_time)
+  );
+
+  wire [EVENT_W-1:0] event_data;
+  wire event_valid, event_ready;
+  /* verilator lint_off PINCONNECTEMPTY */
+  receiver_top u_receiver (
+    .clk(clk), .rst(rst),
+    .s_axis_tdata(sample), .s_axis_tvalid(sample_valid), .s_axis_tready(sample_ready),
+    .m_axis_tdata(event_data), .m_axis_tvalid(event_valid), .m_axis_tready(event_ready),
+    .dbg_filter_valid(), .dbg_filter_data(), .dbg_filter_sections(),
+    .dbg_bank_valid(), .dbg_weighted(), .dbg_code(), .dbg_last(), .dbg_energy(), .dbg_index(),
+    .dbg_chip_re(), .dbg_chip_im(), .dbg_corr_re(), .dbg_corr_im()
+  );
+  /* verilator lint_on PINCONNECTEMPTY */
+
+  wire [CODE_W-1:0] ev_code = event_data[0 +: CODE_W];
+  wire signed [ARR_W-1:0] ev_arrival = event_data[CODE_W +: ARR_W];
+  wire [SCORE_W-1:0] ev_score = event_data[CODE_W + ARR_W +: SCORE_W];
+  wire [SCORE_W-1:0] ev_margin = event_data[CODE_W + ARR_W + SCORE_W +: SCORE_W];
+
+  wire m_valid, m_ready;
+  wire [CODE_W-1:0] m_code;
+  wire [1:0] m_flags;
+  wire [31:0] m_tof, m_distance;
+  wire [SCORE_W-1:0] m_score, m_margin;
+  /* verilator lint_off PINCONNECTEMPTY */
+  tof_distance #(.CODES(CODES), .CODE_W(CODE_W), .TIME_W(TIME_W), .FRAC_W(FRAC_W),
+                 .PERIOD_T(PERIOD_T), .SCORE_W(SCORE_W), .OFF_W(OFF_W), .OFFSETS(OFFSETS),
+                 .C_W(32), .C_FRAC(C_FRAC), .C_INIT(C_INIT), .TOF_W(32), .DIST_W(32)) u_tof (
+    .clk(clk), .rst(rst),
+    .burst_valid(burst_valid), .burst_code(burst_code), .burst_time(burst_time),
+    .c_wr(c_wr), .c_value(c_value), .c_current(),
+    .s_valid(event_valid), .s_ready(event_ready),
+    .s_code(ev_code), .s_arrival(ev_arrival), .s_score(ev_score), .s_margin(ev_margin),
+    .m_valid(m_valid), .m_ready(m_ready), .m_code(m_code), .m_flags(m_flags),
+    .m_tof(m_tof), .m_distance(m_distance), .m_score(m_score), .m_margin(m_margin)
+  );
+  /* verilator lint_on PINCONNECTEMPTY */
+
+  // 16-bit fields of the frame: a narrower score is zero-extended, a wider one keeps its top bits.
+  wire [15:0] f_score, f_margin;
+  generate
+    if (SCORE_W >= 16) begin : g_score_wide
+      assign f_score = m_score[SCORE_W-1 -: 16];
+      assign f_margin = m_margin[SCORE_W-1 -: 16];
+    end else begin : g_score_narrow
+      assign f_score = {{(16-SCORE_W){1'b0}}, m_score};
+      assign f_margin = {{(16-SCORE_W){1'b0}}, m_margin};
+    end
+  endgenerate
+
+  measurement_uart #(.BAUD_DIV(BAUD_DIV)) u_uart (
+    .clk(clk), .rst(rst),
+    .s_valid(m_valid), .s_ready(m_ready),
+    .s_code({{(8-CODE_W){1'b0}}, m_code}),
+    .s_flags({5'd0, led_error, m_flags}),
+    .s_tof(m_tof), .s_distance(m_distance), .s_score(f_score), .s_margin(f_margin),
+    .tx(uart_tx)
+  );
+
+  assign sample_tick = tick;
+  assign meas_valid = m_valid & m_ready;
+
+  // Measurement LED: LED_HOLD clocks per measurement. An up-counter cleared by the event
+  // (one set/reset net for every bit) keeps its carry chain in one piece in the iCE40
+  // tiles; loading the constant LED_HOLD mixed set and reset nets and split the chain.
+  localparam integer LW = $clog2(LED_HOLD + 1);
+  localparam [LW-1:0] LED_LAST = LED_HOLD - 1;
+  reg [LW-1:0] led_count;
+  always @(posedge clk) begin
+    if (rst || (m_valid && m_ready)) led_count <= 0;
+    else if (led_meas) led_count <= led_count + 1'b1;
+    if (rst) led_meas <= 1'b0;
+    else if (m_valid && m_ready) led_meas <= 1'b1;
+    else if (led_count == LED_LAST) led_meas <= 1'b0;
+  end
+
+  wire unused = &{1'b0, overruns};
+endmodule
+
+`default_nettype wire

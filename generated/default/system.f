@@ -1,0 +1,11 @@
+rtl/bandpass_sos.v
+rtl/correlator_bank.v
+rtl/peak_detector.v
+rtl/receiver_top.v
+rtl/adc_interface.v
+rtl/tx_scheduler.v
+rtl/tof_distance.v
+rtl/uart_tx.v
+rtl/measurement_uart.v
+rtl/ranging_system.v
+rtl/ranging_system_top.v

@@ -1,0 +1,89 @@
+////////////////////////////////////////////////////////////////////////////////
+//
+// Filename:  rtl/measurement_uart.v
+//
+// Project:   ranging -- coded ultrasonic ranging system
+//
+// Purpose:   Streams one measurement per frame over the UART (docs/bitstream.md):
+//
+//              byte  0     0xA5                sync
+//              byte  1     0x5A                sync
+//              byte  2     code                1-based code j
+//              byte  3     flags               bit 0: no burst of this code was sent
+//                                              before the arrival (ToF, distance 0)
+//                                              bit 1: distance saturated
+//                                              bit 2: ADC overrun since reset
+//              bytes 4-7   ToF                 unsigned 32, full-rate samples, 8 fraction bits
+//              bytes 8-11  distance            unsigned 32, micrometres
+//              bytes 12-13 score               rho^2, unsigned 16-bit fraction
+//              bytes 14-15 margin              rho^2 best - second, same format
+//              byte  16    checksum            XOR of bytes 2..15
+//
+//            Multi-byte fields little-endian. 17 bytes = 170 bit times
+//            (113 us at 1.5 Mbaud), shorter than a burst period, so one frame
+//            per measurement never backs up.
+//
+// Stream:    s_valid/s_ready: one measurement per frame. Nothing is latched: the
+//            bytes are selected from the s_* inputs, which AXI4-Stream keeps stable
+//            while s_valid && !s_ready, and s_ready completes the handshake when
+//            the frame's last byte is handed to the transmitter (a 17:1 byte
+//            multiplexer instead of a 136-bit frame register). The checksum is a
+//            running XOR of the bytes as they are sent.
+//
+////////////////////////////////////////////////////////////////////////////////
+`default_nettype none
+// Widths of constant expressions (parameters are 32-bit integers) are checked by design.
+/* verilator lint_off WIDTH */
+
+module measurement_uart #(
+  parameter integer BAUD_DIV = 30
+) (
+  input  wire clk, rst,
+  input  wire s_valid,
+  output wire s_ready,
+  input  wire [7:0]  s_code,
+  input  wire [7:0]  s_flags,
+  input  wire [31:0] s_tof,
+  input  wire [31:0] s_distance,
+  input  wire [15:0] s_score,
+  input  wire [15:0] s_margin,
+  output wire tx
+);
+  localparam integer BYTES = 17;
+  reg       busy;
+  reg [4:0] idx;  // byte being sent, 0..BYTES-1
+  wire byte_ready;
+
+  wire [8*14-1:0] payload = {s_margin, s_score, s_distance, s_tof, s_flags, s_code};
+  // checksum: XOR of bytes 2..15 accumulated as they are handed to the transmitter (one 8-bit
+  // register instead of a 14-input XOR tree per bit)
+  reg [7:0] x;
+  wire [8*BYTES-1:0] frame = {8'h00, payload, 8'h5A, 8'hA5};
+  wire last_byte = idx == BYTES - 1;
+  wire [7:0] byte_now = last_byte ? x : frame[8*idx +: 8];
+
+  assign s_ready = busy && last_byte && byte_ready;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      busy <= 1'b0;
+      idx <= 0;
+    end else if (!busy) begin
+      busy <= s_valid;
+      idx <= 0;
+    end else if (byte_ready) begin
+      if (last_byte) busy <= 1'b0;
+      idx <= idx + 1'b1;
+    end
+    if (!busy) x <= 8'h00;
+    else if (byte_ready && idx >= 2) x <= x ^ byte_now;  // byte 16 (x itself) is never added
+  end
+
+  uart_tx #(.BAUD_DIV(BAUD_DIV)) u_tx (
+    .clk(clk), .rst(rst),
+    .s_data(byte_now), .s_valid(busy), .s_ready(byte_ready),
+    .tx(tx)
+  );
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,151 @@
+// `ranging verify` end to end (label hardware: it builds a Verilated receiver at run time):
+// a configuration that is not committed passes every stage; the project's RTL with one
+// operator flipped in the correlator's combiner fails on the combiner stage, upstream stages
+// clean; bad input exits 2 with nothing on stdout.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tests/process.hpp"
+
+namespace fs = std::filesystem;
+using ranging::testing_support::run_tool;
+
+namespace {
+
+const fs::path kRoot = RANGING_SOURCE_DIR;
+
+fs::path scratch() {
+  static const fs::path p = [] {
+    const fs::path d = fs::temp_directory_path() / ("ranging_verify_test_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+  }();
+  return p;
+}
+
+// Not committed: wider filter and bank words, narrower scores, another family.
+fs::path narrow_config() {
+  const fs::path p = scratch() / "narrow.yaml";
+  std::ofstream(p) << "name: narrow-18\nfamily: Gold2\n"
+                      "bandpass_fixed:\n  coef_bits: 18\n  coef_frac: 16\n  data_bits: 18\n  data_frac: 16\n"
+                      "correlator_fixed:\n  chip_bits: 22\n  corr_bits: 18\n  score_bits: 14\n";
+  return p;
+}
+
+// ctest runs each test in its own process: each removes its scratch folder at exit.
+struct Cleanup : ::testing::Environment {
+  void TearDown() override { fs::remove_all(scratch()); }
+};
+const auto* const g_cleanup = ::testing::AddGlobalTestEnvironment(new Cleanup);
+
+nlohmann::json stage(const nlohmann::json& j, const std::string& name) {
+  for (const auto& s : j["stages"]) {
+    if (s["name"] == name) return s;
+  }
+  ADD_FAILURE() << "no stage " << name;
+  return {};
+}
+
+}  // namespace
+
+TEST(Verify, AConfigurationThatIsNotCommittedMatchesTheModelAtEveryStage) {
+  const auto r = run_tool("verify --config " + narrow_config().string() + " --out " + (scratch() / "ok").string() +
+                          " --json");
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["config"], "narrow-18");
+  EXPECT_TRUE(j["pass"].get<bool>());
+  EXPECT_TRUE(j["first_mismatch"].is_null());
+  EXPECT_FALSE(j["version"].get<std::string>().empty());
+  ASSERT_EQ(j["stages"].size(), 7u);
+  for (const auto& s : j["stages"]) {
+    EXPECT_GT(s["compared"].get<long>(), 0) << s["name"];
+    EXPECT_EQ(s["mismatches"].get<long>(), 0) << s["name"];
+  }
+  // Every code of the family is decoded in each coded stream (eta = 9 events per stream).
+  for (const auto& run : j["runs"]) {
+    if (run["name"].get<std::string>().rfind("coded-", 0) == 0) {
+      EXPECT_EQ(run["events"].get<int>(), 9) << run["name"];
+    }
+  }
+  EXPECT_NE(r.err.find("ETA"), std::string::npos) << "progress on stderr";
+  // The work folder holds the IP folder of the configuration.
+  EXPECT_TRUE(fs::exists(scratch() / "ok/ip/files.f"));
+}
+
+TEST(Verify, AFlippedOperatorInTheCombinerFailsOnTheCombinerStage) {
+  const fs::path mine = scratch() / "myrtl";
+  fs::create_directories(mine);
+  for (const auto& e : fs::directory_iterator(kRoot / "rtl")) fs::copy(e.path(), mine / e.path().filename());
+  std::stringstream ss;
+  ss << std::ifstream(mine / "correlator_bank.v").rdbuf();
+  std::string text = ss.str();
+  // C += s F: the adder of the real part becomes a subtractor.
+  const std::string from = "wire [CA_W:0] ca_re_s = {ca_re, 1'b1} + {f_re_m, c_neg};";
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << "the combiner adder moved: update this test";
+  text.replace(at, from.size(), "wire [CA_W:0] ca_re_s = {ca_re, 1'b1} - {f_re_m, c_neg};");
+  std::ofstream(mine / "correlator_bank.v") << text;
+
+  const auto r = run_tool("verify --config " + (kRoot / "configs/default.yaml").string() + " --rtl " + mine.string() +
+                          " --out " + (scratch() / "flip").string() + " --json --quiet");
+  ASSERT_EQ(r.status, 1) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["pass"].get<bool>());
+  EXPECT_EQ(stage(j, "filter")["mismatches"], 0);
+  EXPECT_EQ(stage(j, "chip filter")["mismatches"], 0);
+  EXPECT_GT(stage(j, "combiner")["mismatches"].get<long>(), 0);
+  ASSERT_TRUE(j["first_mismatch"].is_object());
+  EXPECT_EQ(j["first_mismatch"]["stage"], "combiner");
+  EXPECT_NE(j["first_mismatch"]["expected"], j["first_mismatch"]["got"]);
+  EXPECT_NE(j["first_mismatch"]["sample"].get<std::string>().find("sample"), std::string::npos);
+}
+
+TEST(Verify, BadInputExits2WithNothingOnStdout) {
+  struct Case {
+    std::string args, key;
+  } cases[] = {
+      {"", "--config"},
+      {"--config " + (scratch() / "missing.yaml").string(), "missing.yaml"},
+      {"--config " + (kRoot / "configs/default.yaml").string() + " --rtl " + (scratch() / "nope").string(), "--rtl"},
+      {"--config " + (kRoot / "configs/default.yaml").string() + " --bogus", "--bogus"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_tool("verify " + c.args + " --out " + (scratch() / "bad").string());
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
+    EXPECT_EQ(r.out, "") << c.args;
+    EXPECT_NE(r.err.find(c.key), std::string::npos) << c.args << ": " << r.err;
+  }
+}
+
+// A scene through the Verilated receiver: its events equal the fixed model's, so the
+// measurements are exactly those of --precision fixed.
+TEST(SimulateRtl, SceneEventsThroughTheRtlEqualTheFixedModels) {
+  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
+  const auto fixed = run_tool("simulate " + scene + " --precision fixed --quiet --out " + (scratch() / "fixed").string());
+  ASSERT_EQ(fixed.status, 0) << fixed.err;
+  const auto r = run_tool("simulate " + scene + " --precision rtl --json --quiet --out " + (scratch() / "rtl").string());
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["precision"], "rtl");
+  EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
+  EXPECT_EQ(j["rtl"]["mismatches"], 0);
+  EXPECT_GT(j["rtl"]["streams"].get<int>(), 0);
+  EXPECT_GE(j["rtl"]["events_compared"].get<int>(), j["rtl"]["streams"].get<int>());
+  auto read = [](const fs::path& p) {
+    std::stringstream ss;
+    ss << std::ifstream(p).rdbuf();
+    return ss.str();
+  };
+  EXPECT_EQ(read(scratch() / "rtl/measurements.csv"), read(scratch() / "fixed/measurements.csv"));
+  const auto bad = run_tool("simulate " + scene + " --precision float --rtl " + (kRoot / "rtl").string() + " --out " +
+                            (scratch() / "bad").string());
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--rtl"), std::string::npos) << bad.err;
+}

@@ -1,0 +1,208 @@
+// Stimulus driver of a Verilated receiver_top for `ranging verify` and `ranging simulate
+// --precision rtl` (tool/rtl_runner.cpp builds it at run time with `verilator --build` against
+// the generated IP folder of any configuration). It knows no model and no widths: it streams
+// the samples it is given with random valid gaps and back-pressure, and writes every completed
+// tap beat as raw hex port values; the tool decodes the fields and compares them with the
+// golden model stage by stage.
+//
+// Usage: verify_driver STIMULUS OUTPUT
+// STIMULUS (text), any number of runs:
+//   run NAME VALID_PROB READY_PROB SEED RESET_AT QUIET N
+//   x_0 ... x_{N-1}              (s_axis_tdata values, already masked to IN_W bits)
+// RESET_AT: the sample index before which rst is pulsed mid-stream (-1: none). QUIET: clock
+// cycles without any output beat, after the last sample was taken, that end the run.
+// OUTPUT, per run:
+//   run NAME
+//   F <dbg_filter_data> <dbg_filter_sections>                  a filter output (hex)
+//   B <code> <last> <weighted> <energy> <index> <chip_re> <chip_im> <corr_re> <corr_im>
+//   E <m_axis_tdata>                                           an event
+//   R                                                          rst pulsed here
+//   S <samples taken>                                          stalled: s_axis_tready stuck low
+//   end <samples taken> <cycles>
+// Hex values are the whole port, most significant word first (VlWide: 32-bit words).
+// RANGING_TRACE=1 writes RANGING_TRACE_DIR/verify_<NAME>.fst (compiled with --trace-fst).
+#include <verilated.h>
+#if VM_TRACE
+#include <verilated_fst_c.h>
+#endif
+
+#include <cinttypes>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <string>
+#include <type_traits>
+
+#include "Vreceiver_top.h"
+
+namespace {
+
+template <class T>
+void hex(std::FILE* f, const T& v) {
+  static_assert(std::is_integral_v<T>);
+  std::fprintf(f, " %" PRIx64, static_cast<std::uint64_t>(v));
+}
+template <std::size_t N>
+void hex(std::FILE* f, const VlWide<N>& v) {
+  std::fputc(' ', f);
+  for (std::size_t i = N; i-- > 0;) std::fprintf(f, "%08" PRIx32, static_cast<std::uint32_t>(v.at(i)));
+}
+
+class Dut {
+ public:
+  explicit Dut(const std::string& name) : ctx_(std::make_unique<VerilatedContext>()) {
+#if VM_TRACE
+    const char* t = std::getenv("RANGING_TRACE");
+    const bool trace = t != nullptr && std::string(t) == "1";
+    if (trace) ctx_->traceEverOn(true);
+#endif
+    top_ = std::make_unique<Vreceiver_top>(ctx_.get());
+#if VM_TRACE
+    if (trace) {
+      const char* d = std::getenv("RANGING_TRACE_DIR");
+      fst_ = std::make_unique<VerilatedFstC>();
+      top_->trace(fst_.get(), 99);
+      fst_->open(((d && *d ? std::string(d) : std::string(".")) + "/verify_" + name + ".fst").c_str());
+    }
+#else
+    (void)name;
+#endif
+  }
+  ~Dut() {
+    top_->final();
+#if VM_TRACE
+    if (fst_) fst_->close();
+#endif
+  }
+  Vreceiver_top& t() { return *top_; }
+  void eval() { top_->eval(); }
+  void edge() {  // rising then falling edge
+    top_->clk = 1;
+    top_->eval();
+    dump();
+    top_->clk = 0;
+    top_->eval();
+    dump();
+  }
+
+ private:
+  void dump() {
+#if VM_TRACE
+    if (fst_) fst_->dump(ctx_->time());
+#endif
+    ctx_->timeInc(1);
+  }
+  std::unique_ptr<VerilatedContext> ctx_;
+  std::unique_ptr<Vreceiver_top> top_;
+#if VM_TRACE
+  std::unique_ptr<VerilatedFstC> fst_;
+#endif
+};
+
+void reset(Dut& d) {
+  d.t().rst = 1;
+  d.t().s_axis_tvalid = 0;
+  d.t().m_axis_tready = 0;
+  for (int i = 0; i < 4; ++i) {
+    d.t().clk = 0;
+    d.eval();
+    d.edge();
+  }
+  d.t().rst = 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: verify_driver STIMULUS OUTPUT\n");
+    return 2;
+  }
+  std::FILE* in = std::fopen(argv[1], "r");
+  std::FILE* out = std::fopen(argv[2], "w");
+  if (!in || !out) {
+    std::fprintf(stderr, "verify_driver: cannot open %s or %s\n", argv[1], argv[2]);
+    return 2;
+  }
+  char name[256];
+  double valid_prob, ready_prob;
+  unsigned long long seed, quiet, n;
+  long long reset_at;
+  while (std::fscanf(in, " run %255s %lf %lf %llu %lld %llu %llu", name, &valid_prob, &ready_prob, &seed, &reset_at,
+                     &quiet, &n) == 7) {
+    std::vector<std::uint64_t> x(n);
+    for (auto& v : x) {
+      if (std::fscanf(in, "%" SCNu64, &v) != 1) {
+        std::fprintf(stderr, "verify_driver: run %s: short sample list\n", name);
+        return 2;
+      }
+    }
+    std::fprintf(out, "run %s\n", name);
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Dut d(name);
+    reset(d);
+    std::size_t next = 0;
+    std::uint64_t cycles = 0, idle = 0, silent = 0;
+    bool stalled = false;
+    while (next < x.size() || silent < quiet) {
+      if (reset_at >= 0 && next == static_cast<std::size_t>(reset_at)) {
+        reset(d);
+        std::fprintf(out, "R\n");
+        reset_at = -1;
+      }
+      const bool offer = next < x.size() && u(rng) < valid_prob;
+      d.t().s_axis_tvalid = offer;
+      if (offer) d.t().s_axis_tdata = static_cast<std::remove_reference_t<decltype(d.t().s_axis_tdata)>>(x[next]);
+      d.t().m_axis_tready = u(rng) < ready_prob;
+      d.t().clk = 0;
+      d.eval();
+      bool beat = false;
+      if (offer && d.t().s_axis_tready) {
+        ++next;
+        idle = 0;
+      }
+      auto& t = d.t();
+      if (t.dbg_filter_valid) {
+        std::fputc('F', out);
+        hex(out, t.dbg_filter_data);
+        hex(out, t.dbg_filter_sections);
+        std::fputc('\n', out);
+        beat = true;
+      }
+      if (t.dbg_bank_valid) {
+        std::fputc('B', out);
+        hex(out, t.dbg_code);
+        hex(out, t.dbg_last);
+        hex(out, t.dbg_weighted);
+        hex(out, t.dbg_energy);
+        hex(out, t.dbg_index);
+        hex(out, t.dbg_chip_re);
+        hex(out, t.dbg_chip_im);
+        hex(out, t.dbg_corr_re);
+        hex(out, t.dbg_corr_im);
+        std::fputc('\n', out);
+        beat = true;
+      }
+      if (t.m_axis_tvalid && t.m_axis_tready) {
+        std::fputc('E', out);
+        hex(out, t.m_axis_tdata);
+        std::fputc('\n', out);
+        beat = true;
+      }
+      d.edge();
+      ++cycles;
+      silent = (beat || next < x.size()) ? 0 : silent + 1;
+      if (next < x.size() && ++idle > 200000) {
+        stalled = true;
+        break;
+      }
+    }
+    if (stalled) std::fprintf(out, "S %zu\n", next);
+    std::fprintf(out, "end %zu %" PRIu64 "\n", next, cycles);
+  }
+  std::fclose(out);
+  std::fclose(in);
+  return 0;
+}

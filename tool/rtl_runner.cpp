@@ -1,0 +1,254 @@
+#include "tool/rtl_runner.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "model/base/error.hpp"
+#include "model/hw/hw_generator.hpp"
+#include "model/hw/hw_params.hpp"
+#include "model/hw/ip_package.hpp"
+#include "tool/build_info.hpp"
+
+namespace ranging::tool {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+int shell(const std::string& cmd) {
+  const int st = std::system(cmd.c_str());
+  return (st != -1 && WIFEXITED(st)) ? WEXITSTATUS(st) : -1;
+}
+
+// FNV-1a, 64 bit: the build cache key (stable across runs, unlike std::hash).
+std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+// A hex port value (most significant digit first) as little-endian 64-bit words.
+struct Bits {
+  std::vector<std::uint64_t> w;
+  explicit Bits(const std::string& hex) {
+    int shift = 0;
+    std::uint64_t cur = 0;
+    for (auto it = hex.rbegin(); it != hex.rend(); ++it) {
+      const char c = *it;
+      const std::uint64_t d = c <= '9' ? c - '0' : (c | 0x20) - 'a' + 10;
+      cur |= d << shift;
+      shift += 4;
+      if (shift == 64) {
+        w.push_back(cur);
+        cur = 0;
+        shift = 0;
+      }
+    }
+    if (shift) w.push_back(cur);
+  }
+  std::uint64_t get(int lo, int width) const {
+    std::uint64_t r = 0;
+    for (int b = 0; b < width; ++b) {
+      const int i = lo + b;
+      const std::size_t k = static_cast<std::size_t>(i / 64);
+      if (k < w.size() && ((w[k] >> (i % 64)) & 1u)) r |= std::uint64_t{1} << b;
+    }
+    return r;
+  }
+  std::int64_t sget(int lo, int width) const {
+    const std::uint64_t v = get(lo, width);
+    if (width >= 64) return static_cast<std::int64_t>(v);
+    const std::uint64_t m = std::uint64_t{1} << (width - 1);
+    return static_cast<std::int64_t>(v ^ m) - static_cast<std::int64_t>(m);
+  }
+};
+
+}  // namespace
+
+fs::path default_work_dir(const std::string& what, const std::string& config_name) {
+  const char* t = std::getenv("TMPDIR");
+  const fs::path base = (t && *t) ? fs::path(t) : fs::path("/tmp");
+  std::string safe;
+  for (char c : config_name) safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+  return base / ("ranging-" + what + "-" + std::to_string(::getuid()) + "-" + safe);
+}
+
+RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& options)
+    : design_(design), opt_(options) {
+  const auto mods = hardware_parameters(design);
+  auto value = [&](const char* mod, const char* name) {
+    for (const auto& m : mods) {
+      if (m.module == mod) return static_cast<int>(m.value(name));
+    }
+    throw std::logic_error(std::string("no module ") + mod);
+  };
+  in_w_ = value("bandpass_sos", "IN_W");
+  data_w_ = value("bandpass_sos", "DATA_W");
+  sections_ = value("bandpass_sos", "SECTIONS");
+  chip_w_ = value("correlator_bank", "CHIP_W");
+  corr_w_ = value("correlator_bank", "CORR_W");
+  time_w_ = value("correlator_bank", "TIME_W");
+  code_w_ = value("peak_detector", "CODE_W");
+  frac_w_ = value("peak_detector", "FRAC_W");
+  score_w_ = value("peak_detector", "SCORE_W");
+
+  const std::string src = build_info::kSourceDir;
+  if (opt_.rtl_dir.empty()) opt_.rtl_dir = src + "/rtl";
+  const fs::path work = fs::absolute(opt_.work_dir);
+  opt_.work_dir = work;
+  std::error_code ec;
+  fs::create_directories(work, ec);
+  if (ec) throw InputError("--out: cannot create " + work.string() + ": " + ec.message());
+
+  // 1. The IP folder of this configuration (the user's RTL when --rtl is given).
+  auto files = generate_hardware_files(design, opt_.origin);
+  add_ip_package(files, design, opt_.rtl_dir, src + "/hls", build_info::kVersion, opt_.rtl_option);
+  write_hardware_files(files, (work / "ip").string());
+
+  // 2. The Verilated driver, rebuilt only when a source or the command changes.
+  const fs::path driver_src = fs::path(src) / "tb/verify_driver.cpp";
+  if (!fs::exists(driver_src)) throw InputError("cannot find the testbench source " + driver_src.string());
+  if (shell("command -v verilator >/dev/null 2>&1") != 0) {
+    throw InputError("verilator is not installed (Debian: apt-get install verilator)");
+  }
+  const fs::path obj = work / "obj";
+  driver_ = obj / "verify_driver";
+  const std::string cmd = "cd " + quote((work / "ip").string()) +
+                          " && verilator --cc --exe --build -j 2 -Wno-fatal -Wno-lint -Wno-style"
+                          " --x-assign unique --x-initial unique -O3 -CFLAGS -O1" +
+                          std::string(opt_.trace ? " --trace-fst" : "") +
+                          " -f files.f --top-module receiver_top --Mdir " + quote(obj.string()) +
+                          " -o verify_driver " + quote(driver_src.string());
+  std::uint64_t key = fnv1a(cmd + read(driver_src));
+  std::istringstream list(read(work / "ip/files.f"));
+  for (std::string line; std::getline(list, line);) key = fnv1a(read(work / "ip" / line), key);
+  const std::string stamp = std::to_string(key);
+  const fs::path stamp_file = obj / ".ranging-stamp";
+  if (fs::exists(driver_) && read(stamp_file) == stamp) return;
+  const fs::path log = work / "build.log";
+  if (!opt_.quiet) {
+    std::cerr << "building the Verilated receiver_top of '" << design.config.name << "' in " << work.string()
+              << " (verilator --build: about 1-2 minutes) ..." << std::flush;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  fs::remove(stamp_file, ec);
+  const int rc = shell(cmd + " > " + quote(log.string()) + " 2>&1");
+  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!opt_.quiet) std::cerr << (rc == 0 ? " done" : " failed") << " in " << static_cast<int>(build_seconds_) << " s\n";
+  if (rc != 0 || !fs::exists(driver_)) {
+    std::string first;
+    std::istringstream ls(read(log));
+    for (std::string line; std::getline(ls, line);) {
+      if (line.find("%Error") != std::string::npos || line.find("error:") != std::string::npos) {
+        first = line;
+        break;
+      }
+    }
+    throw InputError(opt_.rtl_option + ": the Verilated receiver does not build from the RTL in " + opt_.rtl_dir + " (" +
+                     (first.empty() ? "see the log" : first) + "); log: " + log.string());
+  }
+  std::ofstream(stamp_file) << stamp;
+  rebuilt_ = true;
+}
+
+std::vector<RtlResult> RtlReceiver::run(const std::vector<RtlStimulus>& stimuli) const {
+  const fs::path dir = opt_.work_dir / "runs";
+  fs::create_directories(dir);
+  const fs::path stim = dir / "stimulus.txt", out = dir / "taps.txt";
+  {
+    std::ofstream f(stim);
+    const std::uint64_t mask = (std::uint64_t{1} << in_w_) - 1;
+    for (const auto& s : stimuli) {
+      f << "run " << s.name << " " << s.valid_prob << " " << s.ready_prob << " " << s.seed << " " << s.reset_at
+        << " 50000 " << s.x.size() << "\n";
+      for (std::size_t i = 0; i < s.x.size(); ++i) {
+        f << (static_cast<std::uint64_t>(s.x[i]) & mask) << ((i + 1) % 16 == 0 ? "\n" : " ");
+      }
+      f << "\n";
+    }
+    if (!f) throw InputError("cannot write " + stim.string());
+  }
+  std::string env = "RANGING_TRACE_DIR=" + quote(opt_.work_dir.string()) + " ";
+  if (opt_.trace) env += "RANGING_TRACE=1 ";
+  const int rc = shell(env + quote(driver_.string()) + " " + quote(stim.string()) + " " + quote(out.string()));
+  if (rc != 0) throw std::runtime_error("the Verilated driver failed (status " + std::to_string(rc) + ")");
+
+  std::vector<RtlResult> results;
+  std::ifstream f(out);
+  for (std::string line; std::getline(f, line);) {
+    std::istringstream ls(line);
+    std::string tag;
+    ls >> tag;
+    if (tag == "run") {
+      results.emplace_back();
+      ls >> results.back().name;
+      results.back().segments.emplace_back();
+      continue;
+    }
+    if (results.empty()) throw std::runtime_error("driver output: no run header");
+    RtlResult& r = results.back();
+    RtlSegment& seg = r.segments.back();
+    if (tag == "F") {
+      std::string d, s;
+      ls >> d >> s;
+      RtlFilterBeat b;
+      b.data = Bits(d).sget(0, data_w_);
+      const Bits sb(s);
+      for (int k = 0; k < sections_; ++k) b.sections.push_back(sb.sget(k * data_w_, data_w_));
+      seg.filter.push_back(std::move(b));
+    } else if (tag == "B") {
+      std::string code, last, q, e, idx, cre, cim, kre, kim;
+      ls >> code >> last >> q >> e >> idx >> cre >> cim >> kre >> kim;
+      RtlBankBeat b;
+      b.code = static_cast<int>(Bits(code).get(0, code_w_));
+      b.last = Bits(last).get(0, 1) != 0;
+      b.weighted = Bits(q).get(0, design_.layout.weighted_bits);
+      b.energy = Bits(e).get(0, design_.layout.energy_bits);
+      b.index = static_cast<std::int64_t>(Bits(idx).get(0, time_w_));
+      b.chip_re = Bits(cre).sget(0, chip_w_);
+      b.chip_im = Bits(cim).sget(0, chip_w_);
+      b.corr_re = Bits(kre).sget(0, corr_w_);
+      b.corr_im = Bits(kim).sget(0, corr_w_);
+      seg.bank.push_back(b);
+    } else if (tag == "E") {
+      std::string t;
+      ls >> t;
+      const Bits b(t);
+      const int arrival_w = time_w_ + frac_w_ + 1;
+      EventFixed ev;
+      ev.code = static_cast<int>(b.get(0, code_w_));
+      ev.arrival = b.sget(code_w_, arrival_w);
+      ev.score = b.get(code_w_ + arrival_w, score_w_);
+      ev.margin = b.get(code_w_ + arrival_w + score_w_, score_w_);
+      seg.events.push_back(ev);
+    } else if (tag == "R") {
+      r.segments.emplace_back();
+    } else if (tag == "S") {
+      r.stalled = true;
+    } else if (tag == "end") {
+      ls >> r.samples_taken >> r.cycles;
+    }
+  }
+  if (results.size() != stimuli.size()) throw std::runtime_error("driver output: runs missing");
+  return results;
+}
+
+}  // namespace ranging::tool

@@ -1,0 +1,80 @@
+#pragma once
+// The Verilated receiver of any configuration, built at run time (`ranging verify`, and the
+// RTL precision of `ranging simulate`): the IP folder is generated into a work folder (never
+// the source tree), tb/verify_driver.cpp is compiled against it with `verilator --build`
+// (cached: the same sources are not rebuilt), and sample streams are run through it. The
+// driver writes raw port values; this module decodes them with the configuration's widths.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "model/dsp/peak_detector.hpp"
+#include "model/dsp/receiver.hpp"
+
+namespace ranging::tool {
+
+struct RtlBuildOptions {
+  std::string rtl_dir;       // RTL sources (default: the project's rtl/)
+  std::string rtl_option = "--rtl";  // option named in errors about rtl_dir
+  std::filesystem::path work_dir;    // ip/, obj/, runs/ go here
+  std::string origin;        // configuration name for the generated banners
+  bool trace = false;        // compile FST tracing in (RANGING_TRACE=1 switches it on)
+  bool quiet = false;        // no progress on stderr
+};
+
+// Default work folder: $TMPDIR (or /tmp)/ranging-<what>-<uid>-<config name>.
+std::filesystem::path default_work_dir(const std::string& what, const std::string& config_name);
+
+// One stream through the DUT.
+struct RtlStimulus {
+  std::string name;                 // letters, digits, '_', '-', '.'
+  double valid_prob = 1.0, ready_prob = 1.0;
+  std::uint64_t seed = 1;
+  long long reset_at = -1;          // rst pulsed before sample reset_at (-1: never)
+  std::vector<std::int64_t> x;      // signed ADC samples (input_bits)
+};
+
+struct RtlFilterBeat {
+  std::int64_t data = 0;
+  std::vector<std::int64_t> sections;
+};
+struct RtlBankBeat {
+  int code = 0;  // 0-based beat within the group
+  bool last = false;
+  std::uint64_t weighted = 0, energy = 0;
+  std::int64_t index = 0, chip_re = 0, chip_im = 0, corr_re = 0, corr_im = 0;
+};
+// Outputs between two resets.
+struct RtlSegment {
+  std::vector<RtlFilterBeat> filter;
+  std::vector<RtlBankBeat> bank;
+  std::vector<EventFixed> events;
+};
+struct RtlResult {
+  std::string name;
+  std::vector<RtlSegment> segments;  // one more than the resets applied
+  bool stalled = false;
+  std::uint64_t samples_taken = 0, cycles = 0;
+};
+
+class RtlReceiver {
+ public:
+  // Generates and builds (progress on stderr unless quiet). Throws InputError when the
+  // sources do not build (the message names the log).
+  RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& options);
+  std::vector<RtlResult> run(const std::vector<RtlStimulus>& stimuli) const;
+  const std::filesystem::path& work_dir() const { return opt_.work_dir; }
+  double build_seconds() const { return build_seconds_; }
+  bool rebuilt() const { return rebuilt_; }
+
+ private:
+  const ReceiverDesign& design_;
+  RtlBuildOptions opt_;
+  std::filesystem::path driver_;
+  double build_seconds_ = 0;
+  bool rebuilt_ = false;
+  int data_w_, sections_, chip_w_, corr_w_, time_w_, code_w_, frac_w_, score_w_, in_w_;
+};
+
+}  // namespace ranging::tool
