@@ -13,6 +13,7 @@
 #include <map>
 #include <sstream>
 
+#include "model/base/atomic_file.hpp"
 #include "model/sim/capture.hpp"
 #include "model/base/error.hpp"
 #include "model/sim/scene.hpp"
@@ -66,9 +67,7 @@ int cmd_evaluate(const Args& args) {
   Scene scene = load_scene(scene_path);
   const std::string out = p.get_or("--out", "docs/results");
   namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw InputError("option --out: cannot create '" + out + "': " + ec.message());
+  check_output_dir(out, "option --out");
 
   SceneSimulator sim(scene);
   if (!p.has("--json") && !p.has("--quiet")) std::cerr << stages_text(sim);

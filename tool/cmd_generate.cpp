@@ -1,4 +1,5 @@
 // `ranging generate`: the hardware files of one receiver configuration (docs/hardware.md).
+#include <filesystem>
 #include <iostream>
 
 #include "model/config/receiver_config.hpp"
@@ -23,6 +24,12 @@ int cmd_generate(const Args& args) {
   const auto out = p.get("--out");
   if (!config) throw InputError("option --config is required");
   if (!out) throw InputError("option --out is required");
+  {  // the folder is replaced as a whole: never replace a file, and fail before the design work
+    std::error_code ec;
+    if (std::filesystem::exists(*out, ec) && !std::filesystem::is_directory(*out, ec)) {
+      throw InputError("option --out: '" + *out + "' exists and is not a folder; expected a folder");
+    }
+  }
   const ReceiverConfig cfg = load_receiver_config(*config);
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "model/base/atomic_file.hpp"
 #include "model/sim/capture.hpp"
 #include "model/base/error.hpp"
 #include "model/sim/scene.hpp"
@@ -166,13 +167,12 @@ int cmd_simulate(const Args& args) {
   }
   const std::string out = p.get_or("--out", "out/" + scene.name);
   const bool json = p.has("--json");
+  check_output_dir(out, "option --out");  // before anything is printed
   SceneSimulator sim(scene);
   if (!json) std::cout << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim) << std::flush;
 
   namespace fs = std::filesystem;
   std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw InputError("option --out: cannot create '" + out + "': " + ec.message());
   // Captures go to a staging directory that becomes DIR/captures only when the run succeeds.
   const std::string staging = out + "/.captures.tmp";
   if (p.has("--write-captures")) {

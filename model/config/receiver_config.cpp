@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "model/base/error.hpp"
+#include "model/base/input_file.hpp"
 #include "model/config/yaml_reader.hpp"
 
 namespace ranging {
@@ -113,17 +114,13 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
     validate(cfg);
     (void)design_receiver(cfg);  // every derived bound is checked too
   } catch (const InputError& e) {
-    throw InputError(origin + ": " + e.what());
+    throw InputError(yaml::locate(root, origin, e.what()));
   }
   return cfg;
 }
 
 ReceiverConfig load_receiver_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_receiver_config(ss.str(), path);
+  return parse_receiver_config(read_input_file(path, "configuration file", std::size_t{1} << 24), path);
 }
 
 std::string receiver_config_yaml(const ReceiverConfig& c) {

@@ -9,7 +9,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "model/base/atomic_file.hpp"
 #include "model/base/error.hpp"
+#include "model/base/input_file.hpp"
 
 namespace ranging {
 namespace {
@@ -53,6 +55,8 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
   std::string line;
   std::size_t lineno = 0;
   bool data = false;
+  double record_length = -1;  // the header's "Record Length" (rows the scope says it wrote)
+  std::size_t record_line = 0;
   while (std::getline(in, line)) {
     ++lineno;
     if (trim(line).empty()) {
@@ -62,7 +66,13 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
     const auto cells = split_cells(line);
     double first = 0;
     const bool numeric_first = !cells.empty() && parse_number(cells[0], first);
-    if (!data && !numeric_first) continue;  // header line (before the first data row)
+    if (!data && !numeric_first) {  // header line (before the first data row)
+      if (cells.size() >= 2 && cells[0] == "Record Length" && parse_number(cells[1], first)) {
+        record_length = first;
+        record_line = lineno;
+      }
+      continue;
+    }
     data = true;
     if (cells.size() < 2) fail_at(origin, lineno, "expected 'time,voltage', found one column");
     double val[2];
@@ -83,6 +93,12 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
     t.push_back(val[0]);
     v.push_back(val[1]);
     lines.push_back(lineno);
+  }
+  if (record_length >= 0 && record_length != static_cast<double>(t.size())) {
+    std::ostringstream os;
+    os << "Record Length: the header declares " << record_length << " rows, the file holds " << t.size()
+       << " data rows (truncated?); valid: the number of data rows";
+    fail_at(origin, record_line, os.str());
   }
   if (t.empty()) fail_at(origin, lineno, "no data rows (empty capture; expected rows 'time_s,volts')");
   if (t.size() < 2) fail_at(origin, lineno, "one data row: a capture needs at least two samples");
@@ -204,11 +220,8 @@ Capture read_capture(const std::string& path) {
   if (ext != "csv" && ext != "wav") {
     throw InputError(path + ": unknown capture type '." + ext + "'; valid: .csv (oscilloscope export), .wav");
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the capture file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ext == "csv" ? parse_capture_csv(ss.str(), path) : parse_capture_wav(ss.str(), path);
+  const std::string bytes = read_input_file(path, "capture file", std::size_t{1} << 30);
+  return ext == "csv" ? parse_capture_csv(bytes, path) : parse_capture_wav(bytes, path);
 }
 
 std::string capture_csv(const Capture& c) {
@@ -264,21 +277,6 @@ std::string capture_wav(const Capture& c, WavFormat fmt, double full_scale) {
   return out;
 }
 
-void write_file_atomic(const std::string& path, const std::string& content) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(path + ": cannot write");
-    out << content;
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw InputError(path + ": write failed");
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(path + ": cannot rename the temporary file into place");
-  }
-}
+// write_file_atomic: model/base/atomic_file.cpp (temporary name in the same folder, renamed).
 
 }  // namespace ranging

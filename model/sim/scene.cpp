@@ -11,6 +11,7 @@
 
 #include "model/dsp/codes.hpp"
 #include "model/base/error.hpp"
+#include "model/base/input_file.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/config/yaml_reader.hpp"
 
@@ -215,18 +216,15 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
     ExcitationParams ex{s.excitation.carrier_hz, s.excitation.cycles_per_chip, s.fs, 1.0};
     validate(ex);
   } catch (const InputError& e) {
-    throw InputError(origin + ": " + e.what());
+    throw InputError(yaml::locate(root, origin, e.what()));
   }
   return s;
 }
 
 Scene load_scene(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the scene file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = read_input_file(path, "scene file", std::size_t{1} << 24);
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return parse_scene(ss.str(), path, dir.empty() ? "." : dir);
+  return parse_scene(text, path, dir.empty() ? "." : dir);
 }
 
 }  // namespace ranging
