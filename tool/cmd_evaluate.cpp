@@ -67,7 +67,7 @@ int cmd_evaluate(const Args& args) {
   Scene scene = load_scene(scene_path);
   const std::string out = p.get_or("--out", "docs/results");
   namespace fs = std::filesystem;
-  check_output_dir(out, "option --out");
+  OutputDir out_dir(out, "option --out");  // removed again if the run fails
 
   SceneSimulator sim(scene);
   if (!p.has("--json") && !p.has("--quiet")) std::cerr << stages_text(sim);
@@ -229,6 +229,7 @@ int cmd_evaluate(const Args& args) {
   md << "\nData: `" << scene.name << "-per-code.csv`, `" << scene.name << "-fig13.csv`, `" << scene.name
      << "-summary.json`.\n";
   write_file_atomic(stem + ".md", md.str());
+  out_dir.keep();
 
   if (p.has("--json")) {
     nlohmann::json j;

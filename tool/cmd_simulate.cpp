@@ -167,9 +167,11 @@ int cmd_simulate(const Args& args) {
   }
   const std::string out = p.get_or("--out", "out/" + scene.name);
   const bool json = p.has("--json");
-  check_output_dir(out, "option --out");  // before anything is printed
+  OutputDir out_dir(out, "option --out");  // checked before any work; removed again if the run fails
   SceneSimulator sim(scene);
-  if (!json) std::cout << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim) << std::flush;
+  // stdout is written only once the run has succeeded: a failing command prints nothing there.
+  std::ostringstream text;
+  if (!json) text << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim);
 
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -195,17 +197,23 @@ int cmd_simulate(const Args& args) {
     fs::rename(staging, out + "/captures", ec);
     if (ec) throw InputError("option --out: cannot move captures into place: " + ec.message());
   }
+  out_dir.keep();
   if (json) {
     std::cout << summary.dump(2) << "\n";
   } else {
-    std::printf("\n%-8s %4s %6s %7s %10s %8s %11s %9s %9s\n", "family", "eta", "n", "errors", "rmse_mm", "u_min",
-                "energy_min", "Td_max_us", "vmax_Hz");
+    char line[512];
+    std::snprintf(line, sizeof line, "\n%-8s %4s %6s %7s %10s %8s %11s %9s %9s\n", "family", "eta", "n", "errors",
+                  "rmse_mm", "u_min", "energy_min", "Td_max_us", "vmax_Hz");
+    text << line;
     for (const auto& f : run.summaries) {
-      std::printf("%-8s %4d %6zu %7zu %10.4f %8.4f %11.4g %9.1f %9.0f\n", f.family.c_str(), f.eta, f.measurements,
-                  f.decode_errors, f.rmse_m * 1e3, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz);
+      std::snprintf(line, sizeof line, "%-8s %4d %6zu %7zu %10.4f %8.4f %11.4g %9.1f %9.0f\n", f.family.c_str(), f.eta,
+                    f.measurements, f.decode_errors, f.rmse_m * 1e3, f.u_min, f.energy_min, f.td_max_s * 1e6,
+                    f.vmax_hz);
+      text << line;
     }
-    std::printf("\nwrote %s/measurements.csv, %s/summary.json%s\n", out.c_str(), out.c_str(),
-                p.has("--write-captures") ? (", " + out + "/captures/").c_str() : "");
+    text << "\nwrote " << out << "/measurements.csv, " << out << "/summary.json"
+         << (p.has("--write-captures") ? ", " + out + "/captures/" : std::string()) << "\n";
+    std::cout << text.str();
   }
   return 0;
 }

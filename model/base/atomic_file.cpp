@@ -136,12 +136,17 @@ void check_output_file(const std::string& path, const std::string& what) {
   }
 }
 
-void check_output_dir(const std::string& dir, const std::string& what) {
+std::vector<std::string> check_output_dir(const std::string& dir, const std::string& what) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (dir.empty()) throw InputError(what + ": empty folder name");
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
     throw InputError(what + ": '" + dir + "' exists and is not a folder; expected a folder");
+  }
+  std::vector<std::string> created;
+  for (fs::path p = fs::path(dir).lexically_normal(); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    created.insert(created.begin(), p.string());
+    if (p == p.parent_path()) break;
   }
   fs::create_directories(dir, ec);
   if (ec) throw InputError(what + ": cannot create the folder '" + dir + "': " + ec.message());
@@ -149,9 +154,19 @@ void check_output_dir(const std::string& dir, const std::string& what) {
   std::random_device rd;
   const std::string probe = dir + "/.ranging-probe-" + std::to_string(rd());
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) throw InputError(what + ": folder '" + dir + "' is not writable: " + reason(errno));
+  if (fd < 0) {
+    const int err = errno;
+    for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ec);
+    throw InputError(what + ": folder '" + dir + "' is not writable: " + reason(err));
+  }
   ::close(fd);
   ::unlink(probe.c_str());
+  return created;
+}
+
+OutputDir::~OutputDir() {
+  std::error_code ec;
+  for (auto it = created_.rbegin(); it != created_.rend(); ++it) std::filesystem::remove(*it, ec);  // only if empty
 }
 
 void install_output_cleanup_on_signals() {

@@ -19,6 +19,7 @@
 // or printing: a folder where a file is wanted (or the reverse), a missing or unwritable
 // parent folder are refused with the option's name.
 #include <string>
+#include <vector>
 
 namespace ranging {
 
@@ -27,7 +28,23 @@ void write_file_atomic(const std::string& path, const std::string& content);
 // `what` names the option in the message ("option --out").
 void check_output_file(const std::string& path, const std::string& what);
 // Creates dir (and its parents) if needed and probes that a file can be created in it.
-void check_output_dir(const std::string& dir, const std::string& what);
+// Returns the folders it created, outermost first (for OutputDir).
+std::vector<std::string> check_output_dir(const std::string& dir, const std::string& what);
+
+// An output folder for one run: checked and created by the constructor (check_output_dir);
+// unless keep() is called, the destructor removes the folders it created if they are still
+// empty, so a run that fails leaves no new folder behind.
+class OutputDir {
+ public:
+  OutputDir(const std::string& dir, const std::string& what) : created_(check_output_dir(dir, what)) {}
+  OutputDir(const OutputDir&) = delete;
+  OutputDir& operator=(const OutputDir&) = delete;
+  ~OutputDir();
+  void keep() { created_.clear(); }
+
+ private:
+  std::vector<std::string> created_;
+};
 
 void install_output_cleanup_on_signals();
 

@@ -104,6 +104,13 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
   if (t.size() < 2) fail_at(origin, lineno, "one data row: a capture needs at least two samples");
   const double span = t.back() - t.front();
   const double dt = span / static_cast<double>(t.size() - 1);
+  if (!std::isfinite(span) || !(dt > 0) || !(1.0 / dt >= 1.0 && 1.0 / dt <= 1e12)) {
+    std::ostringstream os;
+    os.precision(9);
+    os << "time: a span of " << span << " s over " << t.size() - 1
+       << " steps is not a sample rate in [1 Hz, 1e12 Hz]";
+    fail_at(origin, lines.back(), os.str());
+  }
   for (std::size_t n = 0; n < t.size(); ++n) {
     const double grid = t.front() + dt * static_cast<double>(n);
     if (std::abs(t[n] - grid) > 0.02 * dt) {
