@@ -2,7 +2,7 @@
 # run_fuzz.sh TARGET SECONDS|runs=N CORPUS SEED_DIR... : fuzz TARGET for SECONDS seconds (or N
 # executions) on CORPUS (created, kept between runs), seeded with the files of each SEED_DIR.
 # A crash, leak, timeout (60 s wall clock: ASan builds on a loaded machine are slow) or UB
-# report fails it; the input is left as CORPUS/../crash-* (copy it
+# report fails it; the input is left in CORPUS/../artifacts-NAME/ (copy it
 # to tests/fuzz/regressions/<target>/). Prints libFuzzer's final stats (executions, coverage).
 set -euo pipefail
 target=$1 budget=$2 corpus=$3
