@@ -97,7 +97,7 @@ TEST(SceneLoader, BadScenesNameFileLineAndField) {
   };
   has(kMinimal + "bogus: 1\n", "s.yaml:3: bogus: unknown key");
   has(kMinimal + "medium:\n  temprature_c: 20\n", "s.yaml:4: medium.temprature_c: unknown key");
-  has(kMinimal + "medium:\n  temperature_c: hot\n", "s.yaml:4: medium.temperature_c: 'hot' has the wrong type");
+  has(kMinimal + "medium:\n  temperature_c: hot\n", "s.yaml:4: medium.temperature_c: 'hot' is not a finite number");
   has(kMinimal + "medium:\n  relative_humidity: 120\n", "s.yaml:4: medium.relative_humidity: 120 is out of range");
   has("geometry:\n  distances_m: [0.5, 30]\n", "s.yaml:2: geometry.distances_m: 30 is out of range");
   has("geometry:\n  distances_m: 0.5\n", "geometry.distances_m: expected a list");

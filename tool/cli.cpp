@@ -69,7 +69,9 @@ bool Parser::parse(const std::vector<std::string>& args) {
       }
       const Opt* o = find(name);
       if (o == nullptr) {
-        throw InputError("unknown option '" + name + "' (see --help)");
+        std::string valid;
+        for (const Opt& k : opts_) valid += (valid.empty() ? "" : ", ") + k.name;
+        throw InputError("unknown option '" + name + "'; valid: " + valid + " (see --help)");
       }
       if (o->name == "--help") {
         std::cout << help_text();
@@ -139,7 +141,9 @@ double Parser::number(const std::string& name, double fallback, double lo, doubl
     const char* e = v->data() + v->size();
     auto [ptr, ec] = std::from_chars(b, e, x);
     if (ec != std::errc() || ptr != e) {
-      throw InputError("option " + name + ": '" + *v + "' is not a number");
+      std::ostringstream os;
+      os << "option " << name << ": '" << *v << "' is not a number; valid range is [" << lo << ", " << hi << "]";
+      throw InputError(os.str());
     }
   }
   std::ostringstream range;
@@ -157,7 +161,9 @@ long long Parser::integer(const std::string& name, long long fallback, long long
     const char* e = v->data() + v->size();
     auto [ptr, ec] = std::from_chars(b, e, x);
     if (ec != std::errc() || ptr != e) {
-      throw InputError("option " + name + ": '" + *v + "' is not an integer");
+      std::ostringstream os;
+      os << "option " << name << ": '" << *v << "' is not an integer; valid range is [" << lo << ", " << hi << "]";
+      throw InputError(os.str());
     }
   }
   if (x < lo || x > hi) {

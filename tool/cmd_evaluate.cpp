@@ -14,6 +14,7 @@
 #include <map>
 #include <sstream>
 
+#include "model/base/atomic_file.hpp"
 #include "model/sim/capture.hpp"
 #include "model/base/error.hpp"
 #include "model/sim/scene.hpp"
@@ -182,9 +183,7 @@ int cmd_evaluate(const Args& args) {
   warn_if_out_of_spec("evaluate", scene.receiver.config);
   const std::string out = p.get_or("--out", "out/" + scene.name);
   namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw InputError("option --out: cannot create '" + out + "': " + ec.message());
+  OutputDir out_dir(out, "option --out");  // removed again if the run fails
 
   SceneSimulator sim(scene);
   if (!p.has("--json") && !p.has("--quiet")) std::cerr << stages_text(sim);
@@ -499,6 +498,7 @@ int cmd_evaluate(const Args& args) {
   md << "\nData: `" << scene.name << "-per-code.csv`, `" << scene.name << "-fig13.csv`, `" << scene.name
      << "-rho-d.csv`, `" << scene.name << "-summary.json`.\n";
   write_file_atomic(stem + ".md", md.str());
+  out_dir.keep();
 
   if (p.has("--json")) {
     nlohmann::json j;

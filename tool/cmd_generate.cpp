@@ -1,4 +1,5 @@
 // `ranging generate`: the hardware files of one receiver configuration (docs/hardware.md).
+#include <filesystem>
 #include <iostream>
 
 #include "model/config/receiver_config.hpp"
@@ -31,6 +32,12 @@ int cmd_generate(const Args& args) {
   const auto out = p.get("--out");
   if (!config) throw InputError("option --config is required");
   if (!out) throw InputError("option --out is required");
+  {  // the folder is replaced as a whole: never replace a file, and fail before the design work
+    std::error_code ec;
+    if (std::filesystem::exists(*out, ec) && !std::filesystem::is_directory(*out, ec)) {
+      throw InputError("option --out: '" + *out + "' exists and is not a folder; expected a folder");
+    }
+  }
   const Overrides overrides = parse_overrides(p.values("--set"));
   const ReceiverConfig cfg = load_receiver_config(*config, overrides, p.has("--allow-out-of-spec"));
   warn_if_out_of_spec("generate", cfg);

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "model/base/atomic_file.hpp"
 #include "model/sim/capture.hpp"
 #include "model/base/error.hpp"
 #include "model/sim/scene.hpp"
@@ -213,16 +214,22 @@ int cmd_simulate(const Args& args) {
   if (scene.geometry.type == "rotor" && p.has("--write-captures")) {
     throw InputError("option --write-captures: not available for rotor scenes");
   }
+  OutputDir out_dir(out, "option --out");  // checked before any work; removed again if the run fails
   SceneSimulator sim(scene);
   RtlSceneCheck rtl_check(p.get_or("--rtl", ""), "", p.has("--quiet"));
   if (rtl) rtl_check.attach(sim);
-  if (!json) std::cout << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim) << std::flush;
+  // stdout is written only once the run has succeeded: a failing command prints nothing there.
+  std::ostringstream text;
+  if (!json) text << "scene " << scene.name << " (" << scene.origin << ")\n" << stages_text(sim);
 
   namespace fs = std::filesystem;
   std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec) throw InputError("option --out: cannot create '" + out + "': " + ec.message());
-  if (scene.geometry.type == "rotor") return simulate_rotor(sim, out, json, p.has("--quiet"));  // tool/rotor_run.hpp
+  if (scene.geometry.type == "rotor") {  // tool/rotor_run.hpp
+    std::cout << text.str() << std::flush;
+    const int status = simulate_rotor(sim, out, json, p.has("--quiet"));
+    out_dir.keep();
+    return status;
+  }
   // Captures go to a staging directory that becomes DIR/captures only when the run succeeds.
   const std::string staging = out + "/.captures.tmp";
   if (p.has("--write-captures")) {
@@ -252,32 +259,36 @@ int cmd_simulate(const Args& args) {
     fs::rename(staging, out + "/captures", ec);
     if (ec) throw InputError("option --out: cannot move captures into place: " + ec.message());
   }
+  out_dir.keep();
   if (json) {
     std::cout << summary.dump(2) << "\n";
   } else {
-    std::printf("\n%-8s %4s %6s %7s %7s %7s %10s %10s %9s %11s %9s %9s %7s %8s\n", "family", "eta", "n", "errors",
-                "det.err", "prs.err", "rmse_mm", "rho2_mrg", "u_min", "energy_min", "Td_max_us", "vmax_Hz", "Td_clip",
-                "Td_noise");
+    char line[512];
+    std::snprintf(line, sizeof line, "\n%-8s %4s %6s %7s %7s %7s %10s %10s %9s %11s %9s %9s %7s %8s\n", "family",
+                  "eta", "n", "errors", "det.err", "prs.err", "rmse_mm", "rho2_mrg", "u_min", "energy_min", "Td_max_us",
+                  "vmax_Hz", "Td_clip", "Td_noise");
+    text << line;
     for (const auto& f : run.summaries) {
-      std::printf("%-8s %4d %6zu %7zu %7zu %7zu %10.4f %10.4f %9.4f %11.4g %9.1f %9.0f %7zu %8zu\n", f.family.c_str(),
-                  f.eta, f.measurements, f.decode_errors, f.detector_errors, f.pearson_errors, f.rmse_m * 1e3,
-                  f.detector_margin_min, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz, f.td_clipped,
-                  f.td_noise_limited);
+      std::snprintf(line, sizeof line, "%-8s %4d %6zu %7zu %7zu %7zu %10.4f %10.4f %9.4f %11.4g %9.1f %9.0f %7zu %8zu\n",
+                    f.family.c_str(), f.eta, f.measurements, f.decode_errors, f.detector_errors, f.pearson_errors,
+                    f.rmse_m * 1e3, f.detector_margin_min, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz,
+                    f.td_clipped, f.td_noise_limited);
+      text << line;
     }
-    std::printf("errors = missed or misdecoded by either decoder; det.err / rho2_mrg: the receiver's (hardware)\n"
-                "rho^2 detector and its smallest per-code mean margin; prs.err / u_min: the paper's Pearson\n"
-                "matched filter (+-L chips) and eq. 10's u; Td_clip / Td_noise: T_d measurements the search\n"
-                "range clipped / whose threshold the noise floor set (docs/signal-model.md)\n");
+    text << "errors = missed or misdecoded by either decoder; det.err / rho2_mrg: the receiver's (hardware)\n"
+            "rho^2 detector and its smallest per-code mean margin; prs.err / u_min: the paper's Pearson\n"
+            "matched filter (+-L chips) and eq. 10's u; Td_clip / Td_noise: T_d measurements the search\n"
+            "range clipped / whose threshold the noise floor set (docs/signal-model.md)\n";
     if (rtl) {
       const auto& r = summary["rtl"];
-      std::cout << "\nRTL (Verilated receiver_top): " << r["streams"] << " streams, " << r["events_compared"]
-                << " events compared with the fixed model, " << r["mismatches"] << " mismatches"
-                << (r["pass"].get<bool>() ? ": identical\n" : "\n");
-      if (!r["first_mismatch"].is_null()) std::cout << "first mismatch: " << r["first_mismatch"].dump() << "\n";
+      text << "\nRTL (Verilated receiver_top): " << r["streams"] << " streams, " << r["events_compared"]
+           << " events compared with the fixed model, " << r["mismatches"] << " mismatches"
+           << (r["pass"].get<bool>() ? ": identical\n" : "\n");
+      if (!r["first_mismatch"].is_null()) text << "first mismatch: " << r["first_mismatch"].dump() << "\n";
     }
-    std::fflush(stdout);
-    std::printf("\nwrote %s/measurements.csv, %s/summary.json, %s/scene.yaml%s\n", out.c_str(), out.c_str(), out.c_str(),
-                p.has("--write-captures") ? (", " + out + "/captures/").c_str() : "");
+    text << "\nwrote " << out << "/measurements.csv, " << out << "/summary.json, " << out << "/scene.yaml"
+         << (p.has("--write-captures") ? ", " + out + "/captures/" : std::string()) << "\n";
+    std::cout << text.str();
   }
   return (rtl && !summary["rtl"]["pass"].get<bool>()) ? 1 : 0;
 }

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "model/base/atomic_file.hpp"
 #include "model/base/error.hpp"
 #include "tool/build_info.hpp"
 #include "tool/commands.hpp"
@@ -74,10 +75,18 @@ int main(int argc, char** argv) {
     print_usage(std::cout);
     return 0;
   }
+  ranging::install_output_cleanup_on_signals();  // Ctrl-C leaves no temporary output file
   for (const Subcommand& c : kSubcommands) {
     if (args[0] == c.name) {
       try {
-        return c.run({args.begin() + 1, args.end()});
+        const int status = c.run({args.begin() + 1, args.end()});
+        // A full disk or a closed pipe on stdout must not pass for success.
+        std::cout.flush();
+        if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+          std::cerr << "ranging " << c.name << ": error: cannot write to standard output (disk full?)\n";
+          return 2;
+        }
+        return status;
       } catch (const ranging::InputError& e) {
         std::cerr << "ranging " << c.name << ": error: " << e.what() << "\n";
         return 2;

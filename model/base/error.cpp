@@ -12,7 +12,11 @@ void require_finite(const std::string& field, double value) {
 }
 
 void require_in_range(const std::string& field, double value, double lo, double hi) {
-  require_finite(field, value);
+  if (!std::isfinite(value)) {
+    std::ostringstream os;
+    os << field << ": value is not a finite number; valid range is [" << lo << ", " << hi << "]";
+    throw InputError(os.str());
+  }
   if (value < lo || value > hi) {
     std::ostringstream os;
     os << field << ": " << value << " is out of range; valid range is [" << lo << ", " << hi << "]";

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "model/base/error.hpp"
+#include "model/base/input_file.hpp"
 #include "model/config/yaml_reader.hpp"
 
 namespace ranging {
@@ -116,7 +117,7 @@ ReceiverConfig parse_document(YAML::Node root, const std::string& origin, bool a
     validate(cfg);
     (void)design_receiver(cfg);  // every derived bound is checked too
   } catch (const InputError& e) {
-    throw InputError(origin + ": " + e.what());
+    throw InputError(yaml::locate(root, origin, e.what()));
   }
   return cfg;
 }
@@ -136,11 +137,8 @@ ReceiverConfig default_receiver_config(const Overrides& overrides) {
 }
 
 ReceiverConfig load_receiver_config(const std::string& path, const Overrides& overrides, bool allow_out_of_spec) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_receiver_config(ss.str(), path, overrides, allow_out_of_spec);
+  return parse_receiver_config(read_input_file(path, "configuration file", std::size_t{1} << 24), path, overrides,
+                               allow_out_of_spec);
 }
 
 std::string receiver_config_yaml(const ReceiverConfig& c) {

@@ -4,24 +4,34 @@
 // error names the file, line and field ("file:line: key: what").
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "model/base/error.hpp"
+#include "model/config/yaml_checks.hpp"
 
 namespace ranging::yaml {
 
-// Parses YAML text; a syntax error names origin and line.
-inline YAML::Node load(const std::string& text, const std::string& origin) {
+// Parses YAML text; a syntax error names origin and line. The text must be UTF-8 (a BOM and
+// CRLF line endings are accepted) and hold one document without duplicate keys, deep nesting
+// or alias bombs (yaml_checks.hpp).
+inline YAML::Node load(const std::string& raw, const std::string& origin) {
+  check_yaml_text(raw, origin);
+  const std::string text = strip_bom(raw);
   try {
+    check_yaml_structure(text, origin);
     return YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw InputError(origin + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+  } catch (const YAML::Exception& e) {
+    throw InputError(origin + ":" + std::to_string(e.mark.line + 1) + ": YAML error: " + e.msg);
   }
 }
 
@@ -30,6 +40,35 @@ inline YAML::Node load(const std::string& text, const std::string& origin) {
   std::ostringstream os;
   os << origin << ":" << node.Mark().line + 1 << ": " << key << ": " << what;
   throw InputError(os.str());
+}
+
+// "origin:line: message" when the message starts with a dotted key ("signal.fs: ...") found
+// in root (the checks made after parsing, e.g. validate(), name keys but not lines), else
+// "origin: message".
+inline std::string locate(const YAML::Node& root, const std::string& origin, const std::string& message) {
+  const auto colon = message.find(':');
+  if (colon != std::string::npos && colon > 0 && root && root.IsMap()) {
+    const std::string key = message.substr(0, colon);
+    if (key.find_first_of(" /()") == std::string::npos) {
+      YAML::Node n;
+      n.reset(root);  // (Node::operator= would assign into the tree)
+      std::size_t at = 0;
+      bool found = true;
+      while (found && at <= key.size()) {
+        const auto dot = std::min(key.find('.', at), key.size());
+        const std::string part = key.substr(at, dot - at);
+        const YAML::Node& cn = n;
+        if (!cn.IsMap() || part.empty() || !cn[part]) {
+          found = false;
+        } else {
+          n.reset(cn[part]);
+        }
+        at = dot + 1;
+      }
+      if (found && n.Mark().line >= 0) return origin + ":" + std::to_string(n.Mark().line + 1) + ": " + message;
+    }
+  }
+  return origin + ": " + message;
 }
 
 // A strict mapping reader: get() marks a key as known; finish() refuses the unknown ones.
@@ -51,19 +90,32 @@ class Reader {
     out = scalar<T>(v, key(k));
     return true;
   }
+  // `valid` (e.g. "; valid range is [1, 64]") is appended to the type and finiteness errors.
   template <class T>
-  T scalar(const YAML::Node& v, const std::string& name) const {
-    if (!v.IsScalar()) fail(origin_, v, name, "expected a scalar");
+  T scalar(const YAML::Node& v, const std::string& name, const std::string& valid = "") const {
+    if (!v.IsScalar()) fail(origin_, v, name, "expected a scalar (" + type_name<T>() + ")" + valid);
     T out{};
     try {
       out = v.as<T>();
     } catch (const YAML::Exception&) {
-      fail(origin_, v, name, "'" + v.Scalar() + "' has the wrong type");
+      fail(origin_, v, name, "'" + v.Scalar() + "' is not " + type_name<T>() + valid);
     }
     if constexpr (std::is_floating_point_v<T>) {
-      if (!std::isfinite(out)) fail(origin_, v, name, "value is not finite");
+      if (!std::isfinite(out)) fail(origin_, v, name, "'" + v.Scalar() + "' is not a finite number" + valid);
     }
     return out;
+  }
+  template <class T>
+  static std::string type_name() {
+    if constexpr (std::is_same_v<T, bool>) {
+      return "true or false";
+    } else if constexpr (std::is_integral_v<T>) {
+      return "an integer (in the range of its type)";
+    } else if constexpr (std::is_floating_point_v<T>) {
+      return "a finite number";
+    } else {
+      return "a string";
+    }
   }
   template <class T>
   bool get_opt(const std::string& k, std::optional<T>& out) {
@@ -75,7 +127,12 @@ class Reader {
   // A number in [lo, hi]; the error names file, line and field.
   template <class T>
   bool get_range(const std::string& k, T& out, double lo, double hi) {
-    if (!get(k, out)) return false;
+    seen_.insert(k);
+    const YAML::Node v = node_[k];
+    if (!v) return false;
+    std::ostringstream valid;
+    valid << "; valid range is [" << lo << ", " << hi << "]";
+    out = scalar<T>(v, key(k), valid.str());
     check(k, static_cast<double>(out), lo, hi);
     return true;
   }
@@ -112,7 +169,8 @@ class Reader {
   }
   void finish() const {
     for (const auto& kv : node_) {
-      const std::string k = kv.first.as<std::string>();
+      if (!kv.first.IsScalar()) fail(origin_, kv.first, path_.empty() ? "(top)" : path_, "a key must be a plain name");
+      const std::string k = kv.first.Scalar();
       if (!seen_.count(k)) fail(origin_, kv.first, key(k), "unknown key");
     }
   }

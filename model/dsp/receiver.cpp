@@ -166,7 +166,10 @@ ReceiverDesign design_receiver(const ReceiverConfig& cfg_in) {
   // corr_peak (the fixed-point scaling) are the largest |F| and own |C_j| per unit input peak.
   ref.code_gain.assign(d.family.codes.size(), 1.0);
   for (std::size_t j = 0; j < d.family.codes.size(); ++j) {
-    std::vector<double> t(static_cast<std::size_t>(ref.window + 2 * ref.chip_samples), 0.0);
+    // Room for every chip's whole waveform (a slow transducer rings past the trimmed window).
+    const std::size_t last_chip = (d.family.codes[j].size() - 1) * static_cast<std::size_t>(ref.chip_samples);
+    std::vector<double> t(std::max(static_cast<std::size_t>(ref.window + 2 * ref.chip_samples), last_chip + chip.size()),
+                          0.0);
     for (std::size_t c = 0; c < d.family.codes[j].size(); ++c) {
       const double s = d.family.codes[j][c] ? 1.0 : -1.0;
       for (std::size_t n = 0; n < chip.size(); ++n) t[c * ref.chip_samples + n] += s * chip[n];

@@ -12,7 +12,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "model/base/atomic_file.hpp"
 #include "model/base/error.hpp"
+#include "model/base/input_file.hpp"
 
 namespace ranging {
 namespace {
@@ -147,6 +149,8 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
   std::string line;
   std::size_t lineno = 0;
   bool data = false;
+  double record_length = -1;  // the header's "Record Length" (rows the scope says it wrote)
+  std::size_t record_line = 0;
   while (std::getline(in, line)) {
     ++lineno;
     if (trim(line).empty()) {
@@ -157,6 +161,10 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
     double first = 0;
     const bool numeric_first = !cells.empty() && parse_number(cells[0], first);
     if (!data && !numeric_first) {  // header line (before the first data row); metadata keys
+      if (cells.size() >= 2 && cells[0] == "Record Length" && parse_number(cells[1], first)) {
+        record_length = first;
+        record_line = lineno;
+      }
       if (cells.size() >= 2) read_meta_line(c.meta, cells[0], cells[1], origin, lineno);
       continue;
     }
@@ -181,10 +189,23 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
     v.push_back(val[1]);
     lines.push_back(lineno);
   }
+  if (record_length >= 0 && record_length != static_cast<double>(t.size())) {
+    std::ostringstream os;
+    os << "Record Length: the header declares " << record_length << " rows, the file holds " << t.size()
+       << " data rows (truncated?); valid: the number of data rows";
+    fail_at(origin, record_line, os.str());
+  }
   if (t.empty()) fail_at(origin, lineno, "no data rows (empty capture; expected rows 'time_s,volts')");
   if (t.size() < 2) fail_at(origin, lineno, "one data row: a capture needs at least two samples");
   const double span = t.back() - t.front();
   const double dt = span / static_cast<double>(t.size() - 1);
+  if (!std::isfinite(span) || !(dt > 0) || !(1.0 / dt >= 1.0 && 1.0 / dt <= 1e12)) {
+    std::ostringstream os;
+    os.precision(9);
+    os << "time: a span of " << span << " s over " << t.size() - 1
+       << " steps is not a sample rate in [1 Hz, 1e12 Hz]";
+    fail_at(origin, lines.back(), os.str());
+  }
   for (std::size_t n = 0; n < t.size(); ++n) {
     const double grid = t.front() + dt * static_cast<double>(n);
     if (std::abs(t[n] - grid) > 0.02 * dt) {
@@ -301,11 +322,8 @@ Capture read_capture(const std::string& path) {
   if (ext != "csv" && ext != "wav") {
     throw InputError(path + ": unknown capture type '." + ext + "'; valid: .csv (oscilloscope export), .wav");
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the capture file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  Capture c = ext == "csv" ? parse_capture_csv(ss.str(), path) : parse_capture_wav(ss.str(), path);
+  const std::string bytes = read_input_file(path, "capture file", std::size_t{1} << 30);
+  Capture c = ext == "csv" ? parse_capture_csv(bytes, path) : parse_capture_wav(bytes, path);
   const std::string sidecar = path.substr(0, path.size() - 4) + ".json";
   std::ifstream js(sidecar, std::ios::binary);
   if (js) {
@@ -389,21 +407,6 @@ std::string capture_wav(const Capture& c, WavFormat fmt, double full_scale) {
   return out;
 }
 
-void write_file_atomic(const std::string& path, const std::string& content) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(path + ": cannot write");
-    out << content;
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw InputError(path + ": write failed");
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(path + ": cannot rename the temporary file into place");
-  }
-}
+// write_file_atomic: model/base/atomic_file.cpp (temporary name in the same folder, renamed).
 
 }  // namespace ranging

@@ -61,7 +61,7 @@ enum class WavFormat { Pcm16, Pcm24, Float32 };
 // CSV: a Tektronix-like header ("Model,ranging simulate", "Sample Interval,...", "TIME,CH1")
 // then time,volts rows with 9 significant digits. WAV: the sample rate rounded to an integer
 // (refused if it is not one); PCM scales by 1/full_scale and saturates, float writes volts.
-// Both write to PATH.tmp and rename, so a failure leaves no partial file.
+// write_file_atomic (model/base/atomic_file.hpp) writes a temporary name and renames it.
 // capture_csv writes c.meta's fields as header lines (before "TIME,CH1").
 std::string capture_csv(const Capture& c);
 std::string capture_wav(const Capture& c, WavFormat fmt, double full_scale = 1.0);

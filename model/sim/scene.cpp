@@ -12,6 +12,7 @@
 #include "model/dsp/codes.hpp"
 #include "model/sim/capture.hpp"
 #include "model/base/error.hpp"
+#include "model/base/input_file.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/stability.hpp"
 #include "model/config/yaml_reader.hpp"
@@ -248,7 +249,7 @@ Scene parse_document(YAML::Node root, const std::string& origin, const std::stri
     ExcitationParams ex{s.excitation.carrier_hz, s.excitation.cycles_per_chip, s.fs, 1.0};
     validate(ex);
   } catch (const InputError& e) {
-    throw InputError(origin + ": " + e.what());
+    throw InputError(yaml::locate(root, origin, e.what()));
   }
 
   // The effective scene document: paths made absolute (the configuration goes beside it).
@@ -274,12 +275,9 @@ Scene parse_scene(const std::string& text, const std::string& origin, const std:
 }
 
 Scene load_scene(const std::string& path, const Overrides& overrides, bool allow_out_of_spec) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the scene file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = read_input_file(path, "scene file", std::size_t{1} << 24);
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return parse_scene(ss.str(), path, dir.empty() ? "." : dir, overrides, allow_out_of_spec);
+  return parse_scene(text, path, dir.empty() ? "." : dir, overrides, allow_out_of_spec);
 }
 
 std::string effective_scene_yaml(const Scene& scene, const std::string& config_file) {

@@ -1,0 +1,101 @@
+// Interruption (issue 18, section 5): SIGINT or SIGTERM during `ranging simulate` or
+// `ranging evaluate` leaves the previous outputs intact and no partial or temporary file, and
+// a re-run succeeds. The tool dies of the signal (its handler unlinks the temporaries of
+// model/base/atomic_file.hpp and re-raises), so the exit is "killed by SIGINT/SIGTERM".
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/process.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::map<std::string, std::string> files_in(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file()) out[fs::relative(e.path(), dir).string()] = slurp(e.path());
+  }
+  return out;
+}
+
+// Starts the tool, sends sig after delay, returns the wait status.
+int run_and_signal(const std::vector<std::string>& args, int sig, std::chrono::milliseconds delay) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    std::string tool = RANGING_TOOL;
+    argv.push_back(tool.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    const int devnull = ::open("/dev/null", O_WRONLY);
+    ::dup2(devnull, 1);
+    ::dup2(devnull, 2);
+    ::execv(tool.c_str(), argv.data());
+    ::_exit(127);
+  }
+  std::this_thread::sleep_for(delay);
+  ::kill(pid, sig);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return status;
+}
+
+class Interrupt : public ::testing::TestWithParam<int> {};
+
+TEST_P(Interrupt, SimulateLeavesPreviousOutputsAndNoTemporaries) {
+  const int sig = GetParam();
+  const fs::path dir = fs::temp_directory_path() / ("ranging_int_" + std::to_string(::getpid()) + "_" + std::to_string(sig));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // A short run fills the output folder; a long one into the same folder is interrupted.
+  std::ofstream(dir / "short.yaml") << "name: s\ngeometry:\n  distances_m: [0.5]\n";
+  std::ofstream(dir / "long.yaml") << "name: s\ngeometry:\n  distances_m: [0.2, 0.4, 0.6, 0.8, 1.0]\n"
+                                      "  repeats: 400\nnoise:\n  snr_db: 30\n";
+  const std::string out = (dir / "out").string();
+  const auto first = ranging::testing_support::run_tool("simulate --quiet " + (dir / "short.yaml").string() + " --out " + out);
+  ASSERT_EQ(first.status, 0) << first.err;
+  const auto before = files_in(out);
+  ASSERT_EQ(before.count("measurements.csv"), 1u);
+  ASSERT_EQ(before.count("summary.json"), 1u);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const int status = run_and_signal({"simulate", "--quiet", (dir / "long.yaml").string(), "--out", out}, sig,
+                                    std::chrono::milliseconds(700));
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run ended before the signal (" << s << " s): make long.yaml longer";
+  EXPECT_EQ(WTERMSIG(status), sig);
+  EXPECT_EQ(files_in(out), before) << "the interrupted run changed or added files";
+
+  // A re-run works and replaces the outputs whole.
+  const auto again = ranging::testing_support::run_tool("simulate --quiet " + (dir / "short.yaml").string() + " --out " + out);
+  EXPECT_EQ(again.status, 0) << again.err;
+  EXPECT_EQ(files_in(out), before);
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM),
+                         [](const ::testing::TestParamInfo<int>& i) { return i.param == SIGINT ? "SIGINT" : "SIGTERM"; });
+
+}  // namespace
