@@ -162,7 +162,7 @@ TEST(StabilityGuard, ParsedConfigurationIsRefusedNamingTheFile) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()).rfind("bad.yaml: bandpass_fixed.coef_bits: 6", 0), 0u) << e.what();
   }
-  EXPECT_TRUE(parse_receiver_config(kCoef6, "bad.yaml", true).allow_out_of_spec);
+  EXPECT_TRUE(parse_receiver_config(kCoef6, "bad.yaml", {}, true).allow_out_of_spec);
 }
 
 // ------------------------------------------------------------------ every tool path

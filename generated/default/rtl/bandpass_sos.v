@@ -109,7 +109,7 @@ module bandpass_sos #(
   parameter integer ROUNDING  = 1,   // 0 truncate, 1 round half up, 2 convergent
   parameter integer SATURATE  = 1,   // 1 saturate, 0 wrap
   parameter integer SAMPLE_CYCLES = 6,  // clocks available per input sample (shared multipliers need >= 6)
-  parameter [SECTIONS*5*COEF_W-1:0] COEFS = 0  // section k coefficient i (b0,b1,b2,a1,a2) at [(5*k+i)*COEF_W +: COEF_W]
+  parameter [SECTIONS*5*COEF_W-1:0] COEFS = 400'h3e0f842afa5c000005a43cd2894ffcf10000030f3a7a8822fc18000003e838838c68fbd80000042838088b82fc04000003fc  // section k coefficient i (b0,b1,b2,a1,a2) at [(5*k+i)*COEF_W +: COEF_W]
 ) (
   input  wire clk, rst,
   input  wire signed [IN_W-1:0]   s_data,  input wire s_valid, output wire s_ready,

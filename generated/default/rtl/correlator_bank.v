@@ -97,21 +97,9 @@
 //   written since reset to zero, so after reset the outputs equal a fresh model's without a
 //   clearing pass. The group buffer is not cleared: its words are undefined while m_valid
 //   is low (AXI-Stream allows it).
-// Resources (yosys 0.23 synth_ice40 -dsp, defaults):
-//   flattened with m_corr / m_chip unconnected (as in the system), then
-//   nextpnr-ice40 --up5k --pack-only:
-//     2 SB_MAC16, 20 SB_RAM40_4K, 1581 SB_LUT4, 589 DFF, 1770 LCs (1126 LUT-only, 455
-//     LUT+DFF, 134 DFF-only, 89 carry-only), before the quantizers' saturation became a
-//     sign-bit test (in the system synthesis, -noflatten: 1564 -> 1492 SB_LUT4 and 532 -> 454
-//     SB_CARRY).
-//   Then the FIR read-ahead (|Bd| and its sign in 24 DFF) and the combiner's registered chip
-//   sign (timing of the placed system): 1795 LCs standalone with every port connected.
-//   Was 2 / 16 / 1768 / 803, 2227 LCs, with the energy ring and LO tables in DFF/LUT logic,
-//   a separate P accumulator and registers that copied (y, and the Q / F / mix words fanning
-//   out of one LUT to two registers); before that 2 / 13 / 1847 / 1860 (flattened 1815 /
-//   1532) with the
-//   parallel CODES x WEIGHTED_W output register, 7 / 13 / 4217 / 2520 before the
-//   shared-multiplier design.
+// Resources (yosys synth_ice40 -dsp, default parameters, standalone with every port
+//   connected, nextpnr-ice40 --up5k --pack-only): 2 SB_MAC16, 20 SB_RAM40_4K, 1795 logic
+//   cells. How it got there: docs/bitstream.md ("Resource history").
 //
 // Streams (AXI4-Stream rules, data stable while valid && !ready):
 //   s_*: one beat per input sample (s_ready high only when the front end is idle).
@@ -136,24 +124,24 @@ module correlator_bank #(
   parameter integer PERIOD = 25,
   parameter integer LO_W = 16,
   parameter integer MIX_W = 18, MIX_FRAC = 16, MIX_SHIFT = 13,
-  parameter integer DECIM = 5,
+  parameter integer DECIM = 20,
   parameter integer DEC_W = 23,
-  parameter integer TAPS = 81, TAP_W = 16,
-  parameter integer FIR_W = 44,
-  parameter integer CHIP_W = 20, CHIP_SHIFT = 22,
+  parameter integer TAPS = 20, TAP_W = 16,
+  parameter integer FIR_W = 42,
+  parameter integer CHIP_W = 20, CHIP_SHIFT = 20,
   parameter integer CHIPS = 7, CODES = 9,
-  parameter integer CHIP_STEP = 20,
-  parameter integer COMB_W = 23, CORR_W = 16, CORR_SHIFT = 6,
-  parameter integer POWER_W = 31, WEIGHT_W = 16, WEIGHTED_W = 47,
-  parameter integer WINDOW = 1005,
+  parameter integer CHIP_STEP = 5,
+  parameter integer COMB_W = 23, CORR_W = 16, CORR_SHIFT = 7,
+  parameter integer POWER_W = 32, WEIGHT_W = 16, WEIGHTED_W = 48,
+  parameter integer WINDOW = 1000,
   parameter integer ENERGY_W = 41,
   parameter integer TIME_W = 40,
   parameter integer CODE_W = 4,  // width of m_code, >= $clog2(CODES) (the detector's CODE_W)
-  parameter [PERIOD*LO_W-1:0]     LO_COS = 0,
-  parameter [PERIOD*LO_W-1:0]     LO_SIN = 0,
-  parameter [TAPS*TAP_W-1:0]      TAP_VALUES = 0,
-  parameter [CODES*CHIPS-1:0]     CODE_BITS = 0,
-  parameter [CODES*WEIGHT_W-1:0]  WEIGHTS = 0
+  parameter [PERIOD*LO_W-1:0]     LO_COS = 400'h7bfa702a5d4e4495278e0809e804c980ae6a987388fe8103810388fe9873ae6ac980e8040809278e44955d4e702a7bfa7fff,
+  parameter [PERIOD*LO_W-1:0]     LO_SIN = 400'he02bc256a86193ee8645804282458c309d61b4c4d0e2eff5100b2f1e4b3c629f73d07dbb7fbe79bb6c12579f3daa1fd50000,
+  parameter [TAPS*TAP_W-1:0]      TAP_VALUES = 320'h0000003c030e0aca22003b1a58e6748c7ffe7fff755f655052d446bc37782d8c23d61b4716330f48,
+  parameter [CODES*CHIPS-1:0]     CODE_BITS = 63'h6a42d8c44fa3ee53,
+  parameter [CODES*WEIGHT_W-1:0]  WEIGHTS = 144'hd6be5bc4b762504964e54068378365789e12
 ) (
   /* verilator lint_on UNUSEDPARAM */
   input  wire clk, rst,
@@ -260,9 +248,16 @@ module correlator_bank #(
   localparam integer NW_L_I = NW - 1;
   localparam [LWT_W-1:0] NW_L = NW_L_I[LWT_W-1:0];
   localparam [SH_W-1:0] SH_ZERO = {SH_W{1'b0}};
-  localparam integer DECIM_I = DECIM;
-  localparam [TIME_W+31:0] DECIM_X = {{TIME_W{1'b0}}, DECIM_I};
-  localparam [TIME_W-1:0] DECIM_T = DECIM_X[TIME_W-1:0];
+  // DECIM as a TIME_W-bit constant (bit by bit: no unsized operand in a concatenation)
+  function [TIME_W-1:0] decim_time;
+    input integer v;
+    integer b;
+    begin
+      decim_time = {TIME_W{1'b0}};
+      for (b = 0; b < 32 && b < TIME_W; b = b + 1) decim_time[b] = v[b];
+    end
+  endfunction
+  localparam [TIME_W-1:0] DECIM_T = decim_time(DECIM);
 
   // Elaboration-time tables: |g| per tap (padded to whole limbs), -LO_SIN, padded weights.
   function [TAPS*TAPM_W-1:0] tap_abs_all;

@@ -28,7 +28,7 @@
 /* verilator lint_off WIDTH */
 
 module ranging_system #(
-  parameter integer CLK_DIV = 9,
+  parameter integer CLK_DIV = 6,
   parameter integer ADC_W = 12,
   parameter integer ADC_OFFSET_BINARY = 1,
   parameter integer CODES = 9,
@@ -36,17 +36,17 @@ module ranging_system #(
   parameter integer SPC = 100,
   parameter integer CYC = 4,
   parameter integer PERIOD_T = 1634,
-  parameter [CODES*CHIPS-1:0] CODE_BITS = 0,
+  parameter [CODES*CHIPS-1:0] CODE_BITS = 63'h6a42d8c44fa3ee53,
   parameter integer CODE_W = 4,
   parameter integer TIME_W = 40,
   parameter integer FRAC_W = 8,
   parameter integer SCORE_W = 16,
   parameter integer OFF_W = 32,
-  parameter [CODES*OFF_W-1:0] OFFSETS = 0,
+  parameter [CODES*OFF_W-1:0] OFFSETS = 288'h0003e8850003e7f90003e4610003e6f50003e6050003e8ad0003eb190003e7590003e691,
   parameter integer C_FRAC = 16,
   parameter [31:0] C_INIT = 32'd4456448,
-  parameter integer BAUD_DIV = 30,
-  parameter integer LED_HOLD = 2250000
+  parameter integer BAUD_DIV = 20,
+  parameter integer LED_HOLD = 1500000
 ) (
   input  wire clk, rst,
   // ADC

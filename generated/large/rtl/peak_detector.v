@@ -77,25 +77,18 @@
 // candidate and MAC flags); data registers and the memory have no reset. The previous-group
 // vector reads as zeros until a group has been taken (Q_prev is written as 0 then; so is Q2
 // when no j != best exceeds 0).
-// Resources (yosys 0.23 synth_ice40 -dsp of peak_detector alone with the default parameters of
-// generated/default/rtl/peak_detector.vc, then nextpnr-ice40 --up5k --pack-only): 1854 logic
-// cells (1109 LUT4 only, 362 LUT4+DFF, 205 DFF only, 156 carry only, 22 carry legalisation),
-// 1 SB_MAC16, 3 SB_RAM40_4K. It was 2035 with a full-width (53-bit, three-segment
-// carry-select) division step, 1638 before the timing work for 33 MHz (the running max's
-// two precomputed compares and word register, the carry-select step and den adder, the
-// pipelined hold-off test), and 2057 before the candidate words moved into the memory. The
-// LUTs are mostly the divider (sources into its 51-bit remainder and divisor, the dQ / sum /
-// den adders and the step adder's operand multiplexers), the
-// MAC digit multiplexers and accumulator, the scan compares, the hold-off test (n - n_cand >=
-// HOLDOFF, compared on HOLDOFF's significant bits only) and the arrival adder.
+// Resources (yosys synth_ice40 -dsp of peak_detector alone with the default parameters, then
+// nextpnr-ice40 --up5k --pack-only): 1854 logic cells, 1 SB_MAC16, 3 SB_RAM40_4K; mostly the
+// divider, the MAC digit multiplexers and accumulator, the scan compares, the hold-off test and
+// the arrival adder. How it got there: docs/bitstream.md ("Resource history").
 `default_nettype none
 
 module peak_detector #(
-  parameter integer CODES = 9, WEIGHTED_W = 47, ENERGY_W = 41, ENERGY_SHIFT = 12,
-  parameter integer SCORE_W = 16, FRAC_W = 8, DECIM = 5, TIME_W = 40,
-  parameter integer HOLDOFF = 1005,
-  parameter [SCORE_W-1:0] THRESHOLD = 0,
-  parameter [ENERGY_W-1:0] MIN_NORM = 0,
+  parameter integer CODES = 9, WEIGHTED_W = 48, ENERGY_W = 41, ENERGY_SHIFT = 12,
+  parameter integer SCORE_W = 16, FRAC_W = 8, DECIM = 20, TIME_W = 40,
+  parameter integer HOLDOFF = 1000,
+  parameter [SCORE_W-1:0] THRESHOLD = 16'h8000,
+  parameter [ENERGY_W-1:0] MIN_NORM = 41'h00000000007,
   parameter integer CODE_W = 4
 ) (
   input  wire clk, rst,
@@ -131,8 +124,16 @@ module peak_detector #(
   localparam integer KM    = (SCORE_W + 1 > FRAC_W) ? SCORE_W + 1 : FRAC_W;  // quotient bits
   localparam integer CW    = $clog2(KM + 1);
   localparam integer FR_W  = FRAC_W + 2;                          // signed fraction
-  localparam integer HOLDOFF_I = HOLDOFF;
-  localparam [TIME_W-1:0] HOLD_T = {{(TIME_W-32){1'b0}}, HOLDOFF_I[31:0]};  // TIME_W >= 32
+  // HOLDOFF as a TIME_W-bit constant (bit by bit: no unsized operand in a concatenation)
+  function [TIME_W-1:0] holdoff_time;
+    input integer v;
+    integer b;
+    begin
+      holdoff_time = {TIME_W{1'b0}};
+      for (b = 0; b < 32 && b < TIME_W; b = b + 1) holdoff_time[b] = v[b];
+    end
+  endfunction
+  localparam [TIME_W-1:0] HOLD_T = holdoff_time(HOLDOFF);
   localparam [SCORE_W-1:0] CAP = {SCORE_W{1'b1}};
   localparam integer HALF_I = (FRAC_W > 0) ? (1 << (FRAC_W - 1)) : 0;
   localparam [FR_W-1:0] HALF = HALF_I[FR_W-1:0];
