@@ -160,7 +160,8 @@ TEST(StabilityGuard, ParsedConfigurationIsRefusedNamingTheFile) {
     parse_receiver_config(kCoef6, "bad.yaml");
     ADD_FAILURE() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("bad.yaml: bandpass_fixed.coef_bits: 6", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("bad.yaml:", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bandpass_fixed.coef_bits: 6"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(parse_receiver_config(kCoef6, "bad.yaml", {}, true).allow_out_of_spec);
 }
@@ -216,7 +217,7 @@ TEST(StabilityCli, GenerateAndDemoRefuseABadConfiguration) {
   const fs::path cfg = write_file("coef6.yaml", kCoef6);
   const fs::path out = temp_path("gen");
   expect_refused("generate --config " + cfg.string() + " --out " + out.string(),
-                 cfg.string() + ": bandpass_fixed.coef_bits: 6, coef_frac: 4: section 5 quantized pole radius 1.000 >= 1");
+                 cfg.string() + ":2: bandpass_fixed.coef_bits: 6, coef_frac: 4: section 5 quantized pole radius 1.000 >= 1");
   EXPECT_FALSE(fs::exists(out));
   expect_refused("demo --quiet --config " + cfg.string(), "bandpass_fixed.coef_bits: 6");
   const fs::path cfg8 = write_file("coef8.yaml", kCoef8);
