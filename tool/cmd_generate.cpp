@@ -26,6 +26,7 @@ int cmd_generate(const Args& args) {
   p.option("--rtl", "DIR", "take the RTL sources from DIR instead of the project's rtl/");
   p.option("--origin", "NAME", "name of the configuration in the generated banners (default: FILE as given)");
   p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): correlator_fixed.chip_bits=18, filter.type=ellip; the effective configuration is written as DIR/config.yaml");
+  p.flag("--no-sources", "write only the configuration-dependent files (tops, parameters, HLS configuration, manifest, README): no copies of rtl/ and hls/, no filelists, no .core; the form committed in generated/");
   p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
   const auto config = p.get("--config");
@@ -45,7 +46,8 @@ int cmd_generate(const Args& args) {
   const ReceiverDesign design = design_receiver(cfg);
   auto files = generate_hardware_files(design, p.get_or("--origin", *config));
   add_ip_package(files, design, p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl"),
-                 std::string(build_info::kSourceDir) + "/hls", build_info::kVersion);
+                 std::string(build_info::kSourceDir) + "/hls", build_info::kVersion, "--rtl",
+                 !p.has("--no-sources"));
   if (!overrides.empty()) files["config.yaml"] = receiver_config_yaml(cfg);  // re-run: --config DIR/config.yaml
   write_hardware_files(files, *out);
   std::cout << "generated " << files.size() << " files for configuration '" << design.config.name

@@ -26,12 +26,14 @@ const std::vector<std::string>& system_rtl_sources();
 // The HLS headers (hls/, one per stage; receiver_hls.hpp includes them all).
 const std::vector<std::string>& hls_sources();
 
-// Reads the RTL sources from rtl_dir and hls/receiver_hls.hpp from hls_dir and adds them to
-// `files` (the output of generate_hardware_files), with files.f, system.f, README.md and
+// Reads the RTL sources from rtl_dir and the HLS headers from hls_dir and adds them to `files`
+// (the output of generate_hardware_files), with files.f, system.f, README.md and
 // <core name>.core. A missing source is an InputError naming it and `rtl_option`.
+// With copy_sources false only the configuration-dependent README.md is added (the form
+// committed in generated/, `ranging generate --no-sources`): no copies, no filelists, no .core.
 void add_ip_package(std::map<std::string, std::string>& files, const ReceiverDesign& design,
                     const std::string& rtl_dir, const std::string& hls_dir, const std::string& version,
-                    const std::string& rtl_option = "--rtl");
+                    const std::string& rtl_option = "--rtl", bool copy_sources = true);
 
 // FuseSoC VLNV name part of a configuration: letters, digits and '_' only.
 std::string core_name(const std::string& config_name);
