@@ -8,4 +8,4 @@ target_compile_definitions(tb_receiver_families_iverilog PRIVATE
   RANGING_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
   RANGING_CONFIG="${PROJECT_SOURCE_DIR}/configs/default.yaml"
   RANGING_TRACE_DIR="${CMAKE_BINARY_DIR}")
-gtest_discover_tests(tb_receiver_families_iverilog DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "hardware" TIMEOUT 900)
+gtest_discover_tests(tb_receiver_families_iverilog DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "hardware" TIMEOUT 900 COST 500)

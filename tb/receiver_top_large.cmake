@@ -1,6 +1,6 @@
 # The large configuration (configs/large.yaml: full rate, 524-tap received template) through the
 # same stage-by-stage testbench as the default.
-ranging_verilator_test(NAME tb_receiver_top_large TOP receiver_top
+ranging_verilator_test(NAME tb_receiver_top_large TOP receiver_top COST 1000
   RTL ${PROJECT_SOURCE_DIR}/generated/large/rtl/receiver_top.v
       ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v
       ${PROJECT_SOURCE_DIR}/rtl/correlator_bank.v
