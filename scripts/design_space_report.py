@@ -1,0 +1,177 @@
+#!/usr/bin/python3
+"""The committed design-space study (issue 11 section 7): docs/results/design-space.{md,json,png}
+from a `ranging sweep` (sweep.json), a `ranging wordlength` (wordlength.json) and the synthesis of
+chosen points (scripts/design_space_synth.sh, one JSON object a line).
+
+  scripts/design_space_report.py SWEEP.json WORDLENGTH.json SYNTH.jsonl OUT_PREFIX [SECONDS]
+
+SECONDS: the sweep's wall time, for points per hour. Accuracy tolerance for "the default's
+accuracy": no decode error and RMSE <= 1.1 x the default's (as ranging wordlength)."""
+import json
+import math
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+UP5K = {"lc": 5280, "mac16": 8, "ebr": 30}
+ECP5_25F = {"lut4": 24288, "mult18": 28, "ebr": 56}
+
+
+def rmse(p):
+    v = p["accuracy"]["distance_rmse_m"]
+    return math.inf if v is None else v
+
+
+def params(p):
+    return ", ".join(f"{k}={v}" for k, v in sorted(p["params"].items())) or "(default)"
+
+
+def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
+    doc = json.load(open(sweep_path))
+    wl = json.load(open(wl_path))
+    synth = [json.loads(line) for line in open(synth_path) if line.strip()]
+    pts = doc["points"]
+    ok = [p for p in pts if p["status"] == "ok"]
+    refused = [p for p in pts if p["status"] != "ok"]
+    default = next(p for p in pts if p["default"])
+    axes = doc["spec"]["axes"]
+    cost = lambda p: p["cost"]["word_bits"]  # noqa: E731
+    front = sorted((p for p in ok if p.get("pareto")), key=cost)
+    front_e = sorted((p for p in ok if p.get("pareto_errors")), key=cost)
+    d_rmse, d_err = rmse(default), default["accuracy"]["decode_errors"]
+    dominators = [p for p in ok if p is not default and cost(p) <= cost(default) and rmse(p) <= d_rmse
+                  and (cost(p) < cost(default) or rmse(p) < d_rmse)]
+    dominators.sort(key=lambda p: (rmse(p), cost(p)))
+    tol = 1.1 * d_rmse
+    as_good = [p for p in ok if p["accuracy"]["decode_errors"] <= d_err and rmse(p) <= tol
+               and p["cost"]["real_time"]]
+    as_good.sort(key=lambda p: (cost(p), p["cost"]["bank_back_end_clocks_per_group"]))
+    rt = sum(1 for p in ok if p["cost"]["real_time"])
+
+    def channels(s):
+        i, e = s["ice40"], s["ecp5"]
+        lc = i["lut4"]  # a logic cell holds one LUT4 and one DFF: LUT4 bounds the cells from below
+        up = min(UP5K["lc"] // max(lc, 1), UP5K["mac16"] // max(i["mac16"], 1) if i["mac16"] else 99,
+                 UP5K["ebr"] // max(i["ebr"], 1) if i["ebr"] else 99)
+        ec = min(ECP5_25F["lut4"] // max(e["lut4"], 1), ECP5_25F["mult18"] // e["mult18"] if e["mult18"] else 99,
+                 ECP5_25F["ebr"] // e["ebr"] if e["ebr"] else 99)
+        return up, ec
+
+    out = {"sweep": sweep_path, "spec": doc["spec"], "points": len(pts), "evaluated": len(ok),
+           "refused": len(refused), "real_time_points": rt, "cost_for_front": "word_bits",
+           "default": default, "front": front, "front_errors": front_e,
+           "default_on_front": bool(default.get("pareto")),
+           "dominated_by": dominators[:3], "as_accurate_as_default": as_good[:10],
+           "synthesis": [dict(s, channels={"up5k": channels(s)[0], "ecp5_25f": channels(s)[1]}) for s in synth],
+           "wordlength": wl, "sweep_seconds": seconds,
+           "points_per_hour": (len(pts) * 3600.0 / seconds) if seconds else None}
+    json.dump(out, open(prefix + ".json", "w"), indent=1)
+
+    fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
+    for ax, (metric, label, fr) in zip(axs, [(lambda p: rmse(p) * 1e3, "distance RMSE (mm)", front),
+                                             (lambda p: p["accuracy"]["decode_errors"], "decode errors", front_e)]):
+        for fam, colour in (("Gold4", "tab:blue"), ("M1", "tab:orange")):
+            sel = [p for p in ok if p["params"].get("scene.excitation.family", "Gold4") == fam]
+            ax.scatter([cost(p) for p in sel], [metric(p) for p in sel], s=16, color=colour, alpha=0.6, label=fam)
+        ax.plot([cost(p) for p in fr], [metric(p) for p in fr], "k-", lw=1, label="Pareto front")
+        ax.scatter([cost(default)], [metric(default)], marker="*", s=160, color="red", label="default", zorder=5)
+        ax.set_xlabel("word_bits (sum of the configured word lengths)")
+        ax.set_ylabel(label)
+        if label.startswith("distance"):
+            ax.set_yscale("log")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"design space: {len(ok)} points evaluated ({len(refused)} refused), fixed model")
+    fig.tight_layout()
+    fig.savefig(prefix + ".png", dpi=110)
+
+    L = []
+    a = default["accuracy"]
+    L.append("# Design-space study (issue 11 section 7)\n")
+    L.append(f"Spec `sweeps/design-space.yaml` (mode {doc['spec']['mode']}, seed {doc['spec'].get('seed')}), "
+             f"scene `sweeps/design-space-scene.yaml` (the paper's Section 4 chain: 5 MS/s, 0.005 V rms, 12-bit "
+             f"ADC at 5 V; 0.1-1.0 m in 0.1 m steps, 2 repeats), base `configs/default.yaml`, fixed model; "
+             f"{len(pts)} points over {len(axes)} axes, {len(ok)} evaluated, {len(refused)} refused by the design "
+             f"(recorded with their error), {rt} of the evaluated keep real time.\n")
+    L.append("Axes: " + "; ".join(f"`{x['key']}` {x['values']}" for x in axes) + ".\n")
+    L.append("Reproduce (the points per hour below were measured with this command):\n")
+    L.append("```sh\nnice -n 10 build/tool/ranging sweep sweeps/design-space.yaml --out out/design-space --no-synth --jobs 2\n"
+             "nice -n 10 build/tool/ranging wordlength sweeps/design-space-wordlength.yaml --out out/wordlength\n"
+             "scripts/design_space_synth.sh out/synth default \"\" small \"...\" > out/synth.jsonl\n"
+             "scripts/design_space_report.py out/design-space/sweep.json out/wordlength/wordlength.json "
+             "out/synth.jsonl docs/results/design-space SECONDS\n```\n")
+    L.append("**Cost on the fronts is `word_bits`** (the sum of the configured word lengths), the sweep's proxy "
+             "without synthesis: this run used `--no-synth` (yosys at ~19 s CPU a point did not fit the shared "
+             "machine's session budget, see below). The iCE40/ECP5 figures are measured by yosys for the points in "
+             "the synthesis table only. Real time: the design's rule (model/hw/realtime.hpp).\n")
+    if seconds:
+        L.append(f"Speed: {len(pts)} points in {seconds:.0f} s wall with `--jobs 2` on the shared 2-core machine: "
+                 f"**{len(pts) * 3600.0 / seconds:.0f} points per hour** without synthesis (with synthesis add "
+                 f"~19 s CPU per distinct RTL: at most ~190 points per hour per core).\n")
+    hdr = "| id | params | word_bits | errors (wrong/missed/false) | RMSE mm | max mm | clk/sample needed / avail | real time | stable |\n|---|---|---|---|---|---|---|---|---|"
+
+    def row(p):
+        q = p["accuracy"]
+        r = "--" if q["distance_rmse_m"] is None else f"{q['distance_rmse_m'] * 1e3:.3f}"
+        m = "--" if q["max_abs_error_m"] is None else f"{q['max_abs_error_m'] * 1e3:.3f}"
+        st = p.get("stability", {}).get("stable")
+        return (f"| {p['id']} | {params(p)} | {cost(p)} | {q['decode_errors']} ({q['wrong_code']}/{q['missed']}/"
+                f"{q['false_alarms']}) | {r} | {m} | {p['cost']['clocks_per_sample_needed']:.2f} / "
+                f"{p['cost']['clocks_per_sample_available']} | {'yes' if p['cost']['real_time'] else 'NO'} | {st} |")
+    L.append("## The default\n")
+    L.append(hdr)
+    L.append(row(default) + "\n")
+    if default.get("pareto"):
+        L.append("The default is **on** the (word_bits, RMSE) front.\n")
+    elif dominators:
+        b = dominators[0]
+        L.append(f"The default is **not** on the (word_bits, RMSE) front: {len(dominators)} points dominate it; "
+                 f"the most accurate, {b['id']} ({params(b)}), has RMSE {rmse(b) * 1e3:.3f} mm vs "
+                 f"{d_rmse * 1e3:.3f} mm ({(1 - rmse(b) / d_rmse) * 100:.0f} % lower) at word_bits {cost(b)} vs "
+                 f"{cost(default)}, {b['accuracy']['decode_errors']} decode errors vs {d_err}.\n")
+    L.append("## Pareto front (word_bits, RMSE)\n")
+    L.append(hdr)
+    L += [row(p) for p in front]
+    L.append("\n## Pareto front (word_bits, decode errors)\n")
+    L.append(hdr)
+    L += [row(p) for p in front_e]
+    L.append(f"\n## As accurate as the default (0 decode errors beyond the default's {d_err}, RMSE <= "
+             f"{tol * 1e3:.3f} mm = 1.1 x), real time, cheapest first\n")
+    L.append(hdr)
+    L += [row(p) for p in as_good[:10]]
+    L.append("\n## Synthesis of chosen points (yosys synth_ice40 -dsp and synth_ecp5 of receiver_top)\n")
+    L.append("| point | overrides | iCE40 LUT4 | DFF | carry | SB_MAC16 | EBR | channels on UP5K | ECP5 LUT4 | FF | MULT18 | EBR | channels on ECP5-25F |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for s in out["synthesis"]:
+        i, e, c = s["ice40"], s["ecp5"], s["channels"]
+        L.append(f"| {s['name']} | {' '.join(s['set']) or '(default)'} | {i['lut4']} | {i['dff']} | {i['carry']} | "
+                 f"{i['mac16']} | {i['ebr']} | {c['up5k']} | {e['lut4']} | {e['ff']} | {e['mult18']} | {e['ebr']} | "
+                 f"{c['ecp5_25f']} |")
+    L.append("\nChannels = min over LUT4 / 5280 logic cells, SB_MAC16 / 8, EBR / 30 (UP5K) and LUT4 / 24288, "
+             "MULT18 / 28, EBR / 56 (ECP5-25F), receiver only (the system around it, UART and transmitter, not "
+             "counted; LUT4 is a lower bound on logic cells). The paper's system has four pairs.\n")
+    L.append("## Per-node minimal widths (`ranging wordlength`, Gold4, the study's scene)\n")
+    L.append("| node | default | minimal |\n|---|---|---|")
+    base_w = wl.get("base", {}).get("widths", {}) if isinstance(wl.get("base"), dict) else {}
+    res_w = wl.get("result", {}).get("widths", {}) if isinstance(wl.get("result"), dict) else {}
+    for n in wl.get("nodes", []):
+        name = n["node"] if isinstance(n, dict) else n
+        L.append(f"| {name} | {n.get('base', base_w.get(name, '')) if isinstance(n, dict) else base_w.get(name, '')} | "
+                 f"{n.get('minimal', res_w.get(name, '')) if isinstance(n, dict) else res_w.get(name, '')} |")
+    L.append("")
+    L.append(f"## Refused points ({len(refused)})\n")
+    reasons = {}
+    for p in refused:
+        e = p.get("error", "")
+        key = e.split(" (with --set")[0]
+        key = key.split(": ", 1)[-1][:110]
+        reasons[key] = reasons.get(key, 0) + 1
+    for k, v in sorted(reasons.items(), key=lambda kv: -kv[1]):
+        L.append(f"- {v} x {k}")
+    open(prefix + ".md", "w").write("\n".join(L) + "\n")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], float(sys.argv[5]) if len(sys.argv) > 5 else None)
