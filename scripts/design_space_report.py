@@ -153,13 +153,12 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
              "MULT18 / 28, EBR / 56 (ECP5-25F), receiver only (the system around it, UART and transmitter, not "
              "counted; LUT4 is a lower bound on logic cells). The paper's system has four pairs.\n")
     L.append("## Per-node minimal widths (`ranging wordlength`, Gold4, the study's scene)\n")
-    L.append("| node | default | minimal |\n|---|---|---|")
-    base_w = wl.get("base", {}).get("widths", {}) if isinstance(wl.get("base"), dict) else {}
-    res_w = wl.get("result", {}).get("widths", {}) if isinstance(wl.get("result"), dict) else {}
+    L.append("| node | default | minimal alone | in the joint result |\n|---|---|---|---|")
     for n in wl.get("nodes", []):
-        name = n["node"] if isinstance(n, dict) else n
-        L.append(f"| {name} | {n.get('base', base_w.get(name, '')) if isinstance(n, dict) else base_w.get(name, '')} | "
-                 f"{n.get('minimal', res_w.get(name, '')) if isinstance(n, dict) else res_w.get(name, '')} |")
+        L.append(f"| {n['key']} | {n['base']} | {n['min']} | {n.get('joint', '')} |")
+    jp = wl.get("joint_params")
+    if jp is not None:
+        L.append(f"\nJoint result: {jp}.")
     L.append("")
     L.append(f"## Refused points ({len(refused)})\n")
     reasons = {}
