@@ -3,7 +3,7 @@
 # `ranging simulate` offers (float model, fixed model, Verilator RTL: --precision rtl runs every
 # stream through the fixed model and the Verilated receiver, whose events must be identical),
 # timed; samples/s = samples of the received streams / wall seconds of the run (the RTL level
-# includes its fixed-model pass and, on a cold cache, the Verilator build); deviation of the
+# includes its fixed-model pass; the Verilator build is done by an untimed warm-up run); deviation of the
 # events (ToF) from the fixed model and from the truth (distance error). Writes OUT.md, OUT.json
 # ({"levels": [{"name", "samples_per_s", "max_deviation", ...}]}).
 #   scripts/fidelity_ladder.sh [SCENE] [OUT_PREFIX]   (default sweeps/smoke-scene.yaml, docs/results/fidelity-ladder)
@@ -14,6 +14,12 @@ scene=${1:-$root/sweeps/smoke-scene.yaml}
 prefix=${2:-$root/docs/results/fidelity-ladder}
 work=$(mktemp -d "${TMPDIR:-/tmp}/ranging-ladder.XXXXXX")
 trap 'rm -rf "$work"' EXIT
+# The Verilated receiver is built at run time in $TMPDIR/ranging-simulate-...: a private TMPDIR
+# (the default folder may hold another tree's build), and one untimed warm-up run builds it.
+export TMPDIR="$work/tmp"
+mkdir -p "$TMPDIR"
+"$ranging" simulate "$scene" --precision rtl --out "$work/warmup" --quiet > "$work/warmup.log" 2>&1 ||
+  { cat "$work/warmup.log" >&2; echo "fidelity_ladder: the RTL warm-up failed" >&2; exit 1; }
 for level in float fixed rtl; do
   t0=$(date +%s.%N)
   "$ranging" simulate "$scene" --precision "$level" --out "$work/$level" --write-captures --quiet > "$work/$level.log" 2>&1 ||

@@ -91,3 +91,40 @@ TEST(RealTime, DefaultManifestSaysRealTime) {
   const auto j = nlohmann::json::parse(in);
   EXPECT_TRUE(j.at("real_time").at("real_time").get<bool>());
 }
+
+// The sweep records the same verdict per point (cost.real_time, with the stage numbers) and the
+// stability guard's verdict.
+TEST(RealTime, SweepPointsCarryTheRuleAndTheStabilityVerdict) {
+  const fs::path dir = fs::temp_directory_path() / ("ranging_realtime_sweep_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.yaml") << "name: tiny\ntransducers: {}\ngeometry:\n  distances_m: [0.3]\n"
+                                       "excitation:\n  family: Gold4\n  codes: [1, 5]\n"
+                                       "noise:\n  noise_v: 0.01\n  seed: 4\n";
+  std::ofstream(dir / "spec.yaml") << "name: rt\nconfig: " << kSource << "/configs/default.yaml\nscene: scene.yaml\n"
+                                   << "mode: grid\naxes:\n  - key: hardware.clock_hz\n    values: [20000000]\n";
+  const auto r = run_tool("sweep " + (dir / "spec.yaml").string() + " --out " + (dir / "out").string() +
+                          " --no-synth --no-plot --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(dir / "out" / "sweep.json");
+  const auto j = nlohmann::json::parse(in);
+  ASSERT_EQ(j.at("points").size(), 2u);
+  for (const auto& p : j.at("points")) {
+    ASSERT_EQ(p.at("status"), "ok") << p.dump();
+    const bool base = p.at("default").get<bool>();
+    const auto expect = base ? budget("default.yaml") : budget("default.yaml", {{"hardware.clock_hz", "20000000"}});
+    const auto& c = p.at("cost");
+    EXPECT_EQ(c.at("real_time").get<bool>(), expect.real_time);
+    EXPECT_EQ(c.at("real_time").get<bool>(), base);
+    EXPECT_EQ(c.at("bank_back_end_clocks_per_group").get<long long>(), expect.bank_back_end_clocks);
+    EXPECT_EQ(c.at("detector_clocks_per_group").get<long long>(), expect.detector_clocks);
+    EXPECT_EQ(c.at("clocks_per_sample_available").get<long long>(), base ? 6 : 4);
+    EXPECT_EQ(c.at("real_time_summary").get<std::string>(), expect.summary());
+    const auto& s = p.at("stability");
+    EXPECT_TRUE(s.at("stable").get<bool>());
+    EXPECT_TRUE(s.at("within_spec").get<bool>());
+    EXPECT_LT(s.at("max_quantized_pole_radius").get<double>(), 1.0);
+    EXPECT_GT(s.at("max_quantized_pole_radius").get<double>(), 0.5);
+  }
+  fs::remove_all(dir);
+}
