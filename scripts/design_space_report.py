@@ -43,8 +43,8 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
     front_e = sorted((p for p in ok if p.get("pareto_errors")), key=cost)
     d_rmse, d_err = rmse(default), default["accuracy"]["decode_errors"]
     fam = lambda p: p["params"].get("scene.excitation.family", "Gold4")  # noqa: E731
-    # The default is a Gold4 receiver: it is compared with Gold4 points (M1 is another code set,
-    # 7 codes of 7 chips against Gold4's 9 of 15: a different system, shown on the fronts).
+    # The default is a Gold4 receiver: it is compared with Gold4 points (M1 is another code set:
+    # 7 codes of 7 chips against Gold4's 9 of 7: another system, shown on the fronts).
     dominators = [p for p in ok if p is not default and fam(p) == "Gold4" and cost(p) <= cost(default) and rmse(p) <= d_rmse
                   and (cost(p) < cost(default) or rmse(p) < d_rmse)]
     dominators.sort(key=lambda p: (rmse(p), cost(p)))
@@ -134,7 +134,8 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
         L.append(f"The default is **not** on the (word_bits, RMSE) front: {len(dominators)} Gold4 points dominate it; "
                  f"the most accurate, {b['id']} ({params(b)}), has RMSE {rmse(b) * 1e3:.3f} mm vs "
                  f"{d_rmse * 1e3:.3f} mm ({(1 - rmse(b) / d_rmse) * 100:.0f} % lower) at word_bits {cost(b)} vs "
-                 f"{cost(default)}, {b['accuracy']['decode_errors']} decode errors vs {d_err}.\n")
+                 f"{cost(default)}, {b['accuracy']['decode_errors']} decode errors vs {d_err}, real time: "
+                 f"{'yes' if b['cost']['real_time'] else 'NO'}.\n")
     L.append("## Pareto front (word_bits, RMSE)\n")
     L.append(hdr)
     L += [row(p) for p in front]
@@ -163,6 +164,22 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
     if jp is not None:
         L.append(f"\nJoint result: {jp}.")
     L.append("")
+    import os
+    large = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "generated", "large", "manifest.json")
+    if os.path.exists(large):
+        lr = json.load(open(large))["real_time"]
+        L.append("## The large configuration\n")
+        L.append("configs/large.yaml (DECIM 1, 524 taps, 90 MHz) is not a point of this sweep (its word lengths "
+                 "and clock differ from the base in several keys at once); the real-time rule refuses it for the "
+                 f"bitstream: {lr['summary']}.\n")
+    L.append("## Notes\n")
+    L.append("- `hardware.clock_hz` is the clocks-per-sample axis: the bandpass shares its multipliers over "
+             "clock_hz / fs clocks (SAMPLE_CYCLES), and 20 MHz (4 clocks) is below the 6 the bandpass needs: "
+             "such points are evaluated (the model is clock-free) but marked NOT real time.")
+    L.append("- `word_bits` ignores the structure (taps, sections, sharing): the synthesis table is the measured cost for the "
+             "points it holds.")
+    L.append("- M1 (7 codes of 7 chips, m-sequence shifts) and Gold4 (9 Gold codes of 7 chips) are different code sets; the default "
+             "(Gold4) is compared with Gold4 points only.\n")
     L.append(f"## Refused points ({len(refused)})\n")
     reasons = {}
     for p in refused:
