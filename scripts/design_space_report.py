@@ -162,7 +162,16 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
         L.append(f"| {n['key']} | {n['base']} | {n['min']} | {n.get('joint', '')} |")
     jp = wl.get("joint_params")
     if jp is not None:
-        L.append(f"\nJoint result: {jp}.")
+        L.append("\nJoint result (passes the tolerance jointly; docs/results/design-space-wordlength-config.yaml): "
+                 + " ".join(f"{k}={v}" for k, v in (jp.items() if isinstance(jp, dict) else jp)) + ".")
+        ws = [s for s in synth if s["name"] == "wordlength"]
+        if ws and synth and synth[0]["name"] == "default":
+            d0, w0 = synth[0]["ice40"], ws[0]["ice40"]
+            L.append(f"\n**Proposed default**: the joint word lengths keep the default's accuracy (0 decode errors, "
+                     f"RMSE within 1.1 x) at {w0['lut4']} LUT4 / {w0['mac16']} SB_MAC16 / {w0['ebr']} EBR against "
+                     f"{d0['lut4']} / {d0['mac16']} / {d0['ebr']} ({(1 - w0['lut4'] / d0['lut4']) * 100:.0f} % fewer LUT4). "
+                     "Not applied to configs/default.yaml here: the bitstream targets (place and route, timing, "
+                     "the equivalence tests) must be re-checked first.")
     L.append("")
     import os
     large = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "generated", "large", "manifest.json")
@@ -179,7 +188,11 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
     L.append("- `word_bits` ignores the structure (taps, sections, sharing): the synthesis table is the measured cost for the "
              "points it holds.")
     L.append("- M1 (7 codes of 7 chips, m-sequence shifts) and Gold4 (9 Gold codes of 7 chips) are different code sets; the default "
-             "(Gold4) is compared with Gold4 points only.\n")
+             "(Gold4) is compared with Gold4 points only.")
+    L.append("- 40 MHz points are receivers only: the system top refuses 40 MHz (clk_hz / baud = 26.67 for its "
+             "1.5 Mbaud UART, `ranging generate`), so they are not bitstream candidates as they stand.")
+    L.append("- The word-length minima hold on this one scene (greedy, monotone assumption, "
+             "docs/design-space.md); a new default needs a margin check on more scenes.\n")
     L.append(f"## Refused points ({len(refused)})\n")
     reasons = {}
     for p in refused:
