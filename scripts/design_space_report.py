@@ -55,10 +55,12 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
     rt = sum(1 for p in ok if p["cost"]["real_time"])
 
     def channels(s):
-        i, e = s["ice40"], s["ecp5"]
+        i, e = s["ice40"], s.get("ecp5")
         lc = i["lut4"]  # a logic cell holds one LUT4 and one DFF: LUT4 bounds the cells from below
         up = min(UP5K["lc"] // max(lc, 1), UP5K["mac16"] // max(i["mac16"], 1) if i["mac16"] else 99,
                  UP5K["ebr"] // max(i["ebr"], 1) if i["ebr"] else 99)
+        if not e:  # not synthesized for ECP5
+            return up, None
         ec = min(ECP5_25F["lut4"] // max(e["lut4"], 1), ECP5_25F["mult18"] // e["mult18"] if e["mult18"] else 99,
                  ECP5_25F["ebr"] // e["ebr"] if e["ebr"] else 99)
         return up, ec
@@ -149,7 +151,9 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
     L.append("\n## Synthesis of chosen points (yosys synth_ice40 -dsp and synth_ecp5 of receiver_top)\n")
     L.append("| point | overrides | iCE40 LUT4 | DFF | carry | SB_MAC16 | EBR | channels on UP5K | ECP5 LUT4 | FF | MULT18 | EBR | channels on ECP5-25F |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for s in out["synthesis"]:
-        i, e, c = s["ice40"], s["ecp5"], s["channels"]
+        i, e, c = s["ice40"], s.get("ecp5") or {}, s["channels"]
+        e = {k: e.get(k, "--") for k in ("lut4", "ff", "mult18", "ebr")}
+        c = {"up5k": c["up5k"], "ecp5_25f": "--" if c["ecp5_25f"] is None else c["ecp5_25f"]}
         L.append(f"| {s['name']} | {' '.join(s['set']) or '(default)'} | {i['lut4']} | {i['dff']} | {i['carry']} | "
                  f"{i['mac16']} | {i['ebr']} | {c['up5k']} | {e['lut4']} | {e['ff']} | {e['mult18']} | {e['ebr']} | "
                  f"{c['ecp5_25f']} |")
