@@ -176,7 +176,7 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
                      f"{w0['lut4']} LUT4 (logic cells >= that), {w0['mac16']} SB_MAC16, {w0['ebr']} EBR: "
                      f"{cw['up5k']} receive channel(s) on the UP5K"
                      + (f", {cw['ecp5_25f']} on an ECP5-25F" if cw["ecp5_25f"] is not None else
-                        " (not synthesized for ECP5; the default's ECP5 figures give the bound below)") + ".")
+                        " (not synthesized for ECP5 in time; the default itself fits 4 on an ECP5-25F, table above)") + ".")
             L.append(f"\n**Proposed default**: the joint word lengths keep the default's accuracy (0 decode errors, "
                      f"RMSE within 1.1 x) at {w0['lut4']} LUT4 / {w0['mac16']} SB_MAC16 / {w0['ebr']} EBR against "
                      f"{d0['lut4']} / {d0['mac16']} / {d0['ebr']} ({(1 - w0['lut4'] / d0['lut4']) * 100:.0f} % fewer LUT4). "
