@@ -105,7 +105,8 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
     L.append("Reproduce (the points per hour below were measured with this command):\n")
     L.append("```sh\nnice -n 10 build/tool/ranging sweep sweeps/design-space.yaml --out out/design-space --no-synth --jobs 2\n"
              "nice -n 10 build/tool/ranging wordlength sweeps/design-space-wordlength.yaml --out out/wordlength\n"
-             "scripts/design_space_synth.sh out/synth default \"\" small \"...\" > out/synth.jsonl\n"
+             "scripts/design_space_synth.sh out/synth default \"\" wordlength \"$(the joint result's KEY=VALUE list, "
+             "table below)\" > out/synth.jsonl\n"
              "scripts/design_space_report.py out/design-space/sweep.json out/wordlength/wordlength.json "
              "out/synth.jsonl docs/results/design-space SECONDS\n```\n")
     L.append("**Cost on the fronts is `word_bits`** (the sum of the configured word lengths), the sweep's proxy "
