@@ -100,6 +100,10 @@ generate() {
 log "generating $(realpath --relative-to="$root" "$config")"
 gen="$out/generated"
 generate "$config" "$gen"
+# The real-time rule (model/hw/realtime.hpp, manifest.json): a design whose stages cannot keep
+# pace with the ADC at the configured clock is refused for the bitstream.
+rt_refusal=$($py -c "import json; r = json.load(open('$gen/manifest.json'))['real_time']; print('' if r['real_time'] else r['summary'])")
+[ -z "$rt_refusal" ] || die "$(realpath --relative-to="$root" "$config") is not a real-time design: $rt_refusal"
 sources=("${receiver_rtl[@]}" "$gen/rtl/receiver_top.v" "${system_rtl[@]}" "$gen/rtl/ranging_system_top.v")
 
 # --- iCE40 -----------------------------------------------------------------------------------

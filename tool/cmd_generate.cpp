@@ -4,6 +4,7 @@
 
 #include "model/config/receiver_config.hpp"
 #include "model/base/error.hpp"
+#include "model/hw/realtime.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
 #include "model/hw/ip_package.hpp"
@@ -50,6 +51,8 @@ int cmd_generate(const Args& args) {
                  !p.has("--no-sources"));
   if (!overrides.empty()) files["config.yaml"] = receiver_config_yaml(cfg);  // re-run: --config DIR/config.yaml
   write_hardware_files(files, *out);
+  const RealTimeBudget rt = realtime_budget(design);  // also in manifest.json
+  if (!rt.real_time) std::cerr << "ranging generate: warning: " << rt.summary() << "\n";
   std::cout << "generated " << files.size() << " files for configuration '" << design.config.name
             << "' in " << *out << "\n";
   return 0;

@@ -9,6 +9,7 @@
 
 #include "model/base/error.hpp"
 #include "model/hw/hw_params.hpp"
+#include "model/hw/realtime.hpp"
 #include "model/hw/hw_system.hpp"
 
 namespace ranging {
@@ -60,6 +61,16 @@ std::string manifest(const ReceiverDesign& d, const std::vector<HwModuleParams>&
   j["config"] = d.config.name;
   j["family"] = d.config.family;
   j["architecture"] = d.config.architecture;
+  // The real-time budget (model/hw/realtime.hpp): the bitstream flow refuses a design that
+  // does not keep pace (scripts/build_bitstream.sh).
+  const RealTimeBudget rt = realtime_budget(d);
+  j["real_time"] = {{"real_time", rt.real_time},
+                    {"clocks_per_sample_available", rt.clocks_per_sample},
+                    {"clocks_per_sample_needed", rt.needed_clocks_per_sample()},
+                    {"group_clocks", rt.group_clocks},
+                    {"bank_back_end_clocks_per_group", rt.bank_back_end_clocks},
+                    {"detector_clocks_per_group", rt.detector_clocks},
+                    {"summary", rt.summary()}};
   for (const auto& m : mods) {
     for (const auto& p : m.params) {
       if (p.element_bits == 0) {

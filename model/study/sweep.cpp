@@ -17,8 +17,10 @@
 #include "model/config/overrides.hpp"
 #include "model/config/receiver_config.hpp"
 #include "model/config/yaml_reader.hpp"
+#include "model/dsp/stability.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
+#include "model/hw/realtime.hpp"
 #include "model/sim/capture.hpp"
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
@@ -307,32 +309,19 @@ json synthesize(const std::map<std::string, std::string>& files, const PointOpti
   return j;
 }
 
-long long ceil16(long long bits) { return (bits + 15) / 16; }
-
-// The design's own throughput rule (rtl/bandpass_sos.v, rtl/correlator_bank.v headers): the
-// bandpass takes at most 6 clocks per sample, the bank's front end 6, its back end
-// 2 TAPS ceil(DEC_W/16) ceil(TAP_W/16) + 1 + CODES (2 ceil(CORR_W/16)^2 + ceil(2 CORR_W/16)
-// ceil(WEIGHT_W/16)) clocks per DECIM samples. The peak detector's group time is not part of
-// the rule (rtl/peak_detector.v bounds it only at the default widths).
+// The design's own throughput rule (model/hw/realtime.hpp: bandpass, bank back end and peak
+// detector against clock_hz / fs).
 json throughput(const ReceiverDesign& d) {
-  const auto mods = hardware_parameters(d);
-  const HwModuleParams* bank = nullptr;
-  for (const auto& m : mods) {
-    if (m.module == "correlator_bank") bank = &m;
-  }
-  if (bank == nullptr) throw InputError("no correlator_bank parameters");
-  const long long taps = bank->value("TAPS"), dec_w = bank->value("DEC_W"), tap_w = bank->value("TAP_W"),
-                  codes = bank->value("CODES"), corr_w = bank->value("CORR_W"), weight_w = bank->value("WEIGHT_W"),
-                  decim = bank->value("DECIM");
-  const long long back = 2 * taps * ceil16(dec_w) * ceil16(tap_w) + 1 +
-                         codes * (2 * ceil16(corr_w) * ceil16(corr_w) + ceil16(2 * corr_w) * ceil16(weight_w));
-  const int available = d.config.sample_cycles();
-  const double back_per_sample = static_cast<double>(back) / static_cast<double>(decim);
-  const double needed = std::max(6.0, back_per_sample);
-  return json{{"clocks_per_sample_available", available}, {"clocks_per_sample_needed", needed},
-              {"bank_back_end_clocks_per_group", back}, {"decimation", decim},
-              {"real_time", needed <= available},
-              {"rule", "max(6 bandpass/front end, bank back end / DECIM) <= clock_hz / fs; peak detector not in the rule"}};
+  const RealTimeBudget r = realtime_budget(d);
+  return json{{"clocks_per_sample_available", r.clocks_per_sample},
+              {"clocks_per_sample_needed", r.needed_clocks_per_sample()},
+              {"bank_back_end_clocks_per_group", r.bank_back_end_clocks},
+              {"detector_clocks_per_group", r.detector_clocks},
+              {"group_clocks", r.group_clocks},
+              {"decimation", r.decimation},
+              {"real_time", r.real_time},
+              {"real_time_summary", r.summary()},
+              {"rule", "model/hw/realtime.hpp: 6 <= clock_hz / fs, bank back end and peak detector <= DECIM clock_hz / fs per group"}};
 }
 
 long long word_bits(const ReceiverConfig& c) {
@@ -421,6 +410,12 @@ json evaluate_point(const SweepSpec& spec, const PointDef& point, const PointOpt
       cost["ice40"] = syn;
     }
     out["cost"] = cost;
+    // The stability guard's verdict (model/dsp/stability.hpp); a design it refuses never gets
+    // here unless the scene allows out-of-spec designs.
+    const DesignGuard guard = check_quantized_design(design);
+    out["stability"] = {{"stable", guard.stable}, {"within_spec", guard.within_spec},
+                        {"max_quantized_pole_radius", jnum(guard.max_quantized_radius())},
+                        {"failures", guard.failures}};
     out["speed"] = {{"fixed_samples_per_s", seconds > 0 ? static_cast<double>(samples) / seconds : 0.0},
                     {"samples", samples}};
     out["status"] = "ok";
@@ -518,8 +513,9 @@ std::string points_csv(const std::vector<json>& points) {
   const std::vector<std::string> acc = {"measurements", "decode_errors", "wrong_code", "missed", "false_alarms",
                                         "distance_rmse_m", "max_abs_error_m", "tof_max_deviation_from_float_s",
                                         "float_disagreements", "u_min", "overflows"};
-  const std::vector<std::string> cost = {"clocks_per_sample_needed", "clocks_per_sample_available", "real_time",
-                                         "word_bits"};
+  const std::vector<std::string> cost = {"clocks_per_sample_needed", "clocks_per_sample_available",
+                                         "bank_back_end_clocks_per_group", "detector_clocks_per_group",
+                                         "group_clocks", "real_time", "word_bits"};
   const std::vector<std::string> ice = {"lut4", "dff", "carry", "mac16", "ebr"};
   std::ostringstream os;
   os << "id,default,status";
@@ -527,7 +523,7 @@ std::string points_csv(const std::vector<json>& points) {
   for (const auto& k : acc) os << "," << k;
   for (const auto& k : cost) os << "," << k;
   for (const auto& k : ice) os << ",ice40_" << k;
-  os << ",pareto,pareto_errors,error\n";
+  os << ",stable,max_pole_radius,pareto,pareto_errors,error\n";
   for (const auto& p : points) {
     os << p.at("id").get<std::string>() << "," << cell(p.at("default")) << "," << p.at("status").get<std::string>();
     for (const auto& k : keys) os << "," << (p["params"].contains(k) ? csv_quote(cell(p["params"][k])) : "");
@@ -537,6 +533,9 @@ std::string points_csv(const std::vector<json>& points) {
     for (const auto& k : ice) {
       os << "," << (ok && p["cost"].contains("ice40") && p["cost"]["ice40"].contains(k) ? cell(p["cost"]["ice40"][k]) : "");
     }
+    const bool has_stab = ok && p.contains("stability");
+    os << "," << (has_stab ? cell(p["stability"]["stable"]) : "") << ","
+       << (has_stab ? cell(p["stability"]["max_quantized_pole_radius"]) : "");
     os << "," << cell(p.value("pareto", json(false))) << "," << cell(p.value("pareto_errors", json(false))) << ","
        << csv_quote(p.value("error", std::string()));
     os << "\n";
