@@ -16,6 +16,8 @@ check=0
 others=1
 breakdown=0
 seeds=1
+jobs=1
+ranging=""
 margin=1.10
 
 usage() {
@@ -31,7 +33,9 @@ Options:
   --config FILE     receiver configuration (default: configs/default.yaml)
   --large FILE      second configuration for the ECP5/Xilinx estimates (default: configs/large.yaml,
                     skipped with a note when absent)
+  --no-large        no second configuration (no large-configuration estimates)
   --build-dir DIR   CMake build folder holding tool/ranging (default: build)
+  --ranging FILE    the ranging tool (default: BUILD/tool/ranging)
   --out DIR         work folder for generated files, netlists, logs and the .bin
                     (default: BUILD/bitstream)
   --results DIR     where the summary goes (default: OUT/results; the committed summary:
@@ -40,6 +44,7 @@ Options:
   --breakdown       also synthesize without flattening and list the iCE40 resources per module
   --seeds N         place and route with nextpnr seeds 1..N and keep the fastest (default 1;
                     each try takes 1-3 minutes; the summary names the seed)
+  --jobs N          place and route up to N seeds at the same time (default 1)
   --check           exit 1 unless the design meets the targets: <= 5280 LUT4, <= 8 SB_MAC16,
                     <= 30 EBR, <= 4 SPRAM, placed and routed, Fmax >= 1.1 x the system clock
   -h, --help        this text
@@ -53,6 +58,10 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --config) config=$(realpath "${2:?--config needs a FILE}"); shift 2 ;;
     --large) large=$(realpath -m "${2:?--large needs a FILE}"); shift 2 ;;
+    --no-large) large=""; shift ;;
+    --ranging) ranging=$(realpath -m "${2:?--ranging needs a FILE}"); shift 2 ;;
+    --jobs) jobs="${2:?--jobs needs N}"; shift 2
+            [[ "$jobs" =~ ^[1-9][0-9]?$ ]] || die "--jobs: N must be 1..99, got '$jobs'" ;;
     --build-dir) build=$(realpath -m "${2:?--build-dir needs a DIR}"); shift 2 ;;
     --out) out=$(realpath -m "${2:?--out needs a DIR}"); shift 2 ;;
     --results) results=$(realpath -m "${2:?--results needs a DIR}"); shift 2 ;;
@@ -74,7 +83,7 @@ for t in yosys nextpnr-ice40 icepack icetime; do
 done
 py=/usr/bin/python3
 [[ -x "$py" ]] || die "/usr/bin/python3 not found"
-ranging="$build/tool/ranging"
+ranging=${ranging:-"$build/tool/ranging"}
 [[ -x "$ranging" ]] || die "$ranging not found: build it first (cmake --build $build --target ranging)"
 
 receiver_rtl=("$root/rtl/bandpass_sos.v" "$root/rtl/correlator_bank.v" "$root/rtl/peak_detector.v")
@@ -126,13 +135,29 @@ pnr_ok=0
 best_seed=0
 best_mhz=-1
 t0=$(date +%s)
-for ((seed = 1; seed <= seeds; seed++)); do
-  log "nextpnr-ice40 --up5k --package sg48 --freq $freq --seed $seed (log: $out/nextpnr.log)"
-  sd="$out/seed-$seed"
+# Seeds are placed and routed in parallel, up to --jobs at a time; the fastest routed one wins
+# (ties: the lowest seed).
+pnr_seed() {
+  local seed=$1 sd="$out/seed-$1"
   mkdir -p "$sd"
   if nice nextpnr-ice40 --up5k --package sg48 --pcf "$pcf" --json "$out/ice40_top.json" \
       --asc "$sd/ice40_top.asc" --freq "$freq" --report "$sd/nextpnr_report.json" \
       --timing-allow-fail --seed "$seed" >"$sd/nextpnr.log" 2>&1; then
+    touch "$sd/ok"
+  fi
+}
+running=0
+for ((seed = 1; seed <= seeds; seed++)); do
+  rm -rf "$out/seed-$seed"
+  log "nextpnr-ice40 --up5k --package sg48 --freq $freq --seed $seed (log: $out/seed-$seed/nextpnr.log)"
+  pnr_seed "$seed" &
+  running=$((running + 1))
+  if ((running >= jobs)); then wait -n || true; running=$((running - 1)); fi
+done
+wait
+for ((seed = 1; seed <= seeds; seed++)); do
+  sd="$out/seed-$seed"
+  if [[ -f "$sd/ok" ]]; then
     # the last "Max frequency" line is the routed design's
     mhz=$(grep -o "Max frequency for clock 'clk': [0-9.]*" "$sd/nextpnr.log" | tail -1 | awk '{print $NF}')
     mhz=${mhz:-0}
@@ -140,8 +165,9 @@ for ((seed = 1; seed <= seeds; seed++)); do
     if [[ $pnr_ok == 0 ]] || awk -v a="$mhz" -v b="$best_mhz" 'BEGIN{exit !(a > b)}'; then
       pnr_ok=1; best_seed=$seed; best_mhz=$mhz
     fi
-  elif [[ $pnr_ok == 0 && $seed == 1 ]]; then
-    cp "$sd/nextpnr.log" "$out/nextpnr.log"   # keep the failure for the summary
+  else
+    log "  seed $seed: nextpnr failed"
+    [[ $pnr_ok == 0 && $seed == 1 ]] && cp "$sd/nextpnr.log" "$out/nextpnr.log"   # keep the failure for the summary
   fi
 done
 if [[ $pnr_ok == 1 ]]; then
@@ -187,12 +213,12 @@ estimate() {  # family cfg_tag gen_dir
 if [[ $others == 1 ]]; then
   estimate ecp5 default "$gen"
   estimate xilinx default "$gen"
-  if [[ -f "$large" ]]; then
+  if [[ -n "$large" && -f "$large" ]]; then
     generate "$large" "$out/generated-large"
     estimate ecp5 large "$out/generated-large"
     estimate xilinx large "$out/generated-large"
   else
-    log "no $large: large-configuration estimates skipped"
+    log "no large configuration ${large:-(--no-large)}: large-configuration estimates skipped"
   fi
 fi
 

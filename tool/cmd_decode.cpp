@@ -22,6 +22,7 @@
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/plot.hpp"
 
 namespace ranging::tool {
 
@@ -32,6 +33,65 @@ struct Setting {
   double value = 0;
   std::string source;  // "option --x", "capture metadata (FILE)", "default"
 };
+
+// decode --plot: the capture, the float receiver's bandpass output (capture units) and the
+// bank's rho^2 per code against time, with the detections; drawn by scripts/plot_decode.py.
+void plot_decode(const std::string& png, const Scene& scene, const std::string& family, const Capture& cap,
+                 double fs, const std::vector<Detection>& dets, const std::vector<Detection>& below) {
+  ReceiverConfig cfg = scene.receiver.config;
+  cfg.family = family;
+  cfg.cycles_per_chip = scene.excitation.q_of(family);
+  fit_decimation_to_chip(cfg);
+  const ReceiverDesign design = design_receiver(cfg);
+  ReceiverFloat rx(design);
+  double peak = 0;
+  for (double v : cap.samples) peak = std::max(peak, std::abs(v));
+  const double scale = peak > 0 ? 0.5 / peak : 1.0;  // as SceneSimulator::decode: half full scale at the peak
+  std::vector<double> filtered;
+  filtered.reserve(cap.samples.size());
+  std::vector<double> t_bank;
+  std::vector<std::vector<double>> rho2(static_cast<std::size_t>(design.family.eta()));
+  for (double v : cap.samples) {
+    (void)rx.execute(v * scale);
+    filtered.push_back(rx.filtered() / scale);
+    if (rx.bank().sample_index() >= 0 && filtered.size() % static_cast<std::size_t>(cfg.decimation) == 0) {
+      t_bank.push_back(cap.t0 + static_cast<double>(rx.bank().sample_index()) / fs);
+      for (std::size_t j = 0; j < rho2.size(); ++j) rho2[j].push_back(rx.bank().rho2(static_cast<int>(j)));
+    }
+  }
+  constexpr std::size_t kBuckets = 4000;
+  const Trace raw = min_max_trace(cap.samples, cap.t0, 1 / fs, kBuckets);
+  const Trace flt = min_max_trace(filtered, cap.t0, 1 / fs, kBuckets);
+  nlohmann::json j;
+  j["title"] = "ranging decode: " + family + ", " + std::to_string(cap.samples.size()) + " samples at " +
+               std::to_string(fs / 1e6).substr(0, 5) + " MS/s";
+  j["capture"] = {{"t", raw.x}, {"v", raw.y}};
+  j["filtered"] = {{"t", flt.x}, {"v", flt.y}};
+  nlohmann::json codes = nlohmann::json::array();
+  for (std::size_t k = 0; k < rho2.size(); ++k) {
+    // the bank's rate is fs / D: thin only long captures (max per bucket keeps the peaks)
+    Trace tr;
+    const std::size_t n = rho2[k].size(), b = std::min<std::size_t>(n, kBuckets);
+    for (std::size_t i = 0; i < b; ++i) {
+      const std::size_t lo = i * n / b, hi = (i + 1) * n / b;
+      std::size_t best = lo;
+      for (std::size_t m = lo; m < hi; ++m) if (rho2[k][m] > rho2[k][best]) best = m;
+      tr.x.push_back(t_bank[best]);
+      tr.y.push_back(rho2[k][best]);
+    }
+    codes.push_back({{"code", k + 1}, {"t", tr.x}, {"rho2", tr.y}});
+  }
+  j["bank"] = codes;
+  j["threshold"] = cfg.detector.threshold;
+  nlohmann::json ds = nlohmann::json::array();
+  for (const auto* list : {&dets, &below}) {
+    for (const auto& d : *list) {
+      ds.push_back({{"code", d.code}, {"arrival_s", d.arrival_s}, {"rho", d.rho_max}, {"passed", list == &dets}});
+    }
+  }
+  j["detections"] = ds;
+  plot_with_script("option --plot", "scripts/plot_decode.py", j, png);
+}
 
 }  // namespace
 
@@ -61,9 +121,11 @@ int cmd_decode(const Args& args) {
   p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   p.option("--calibrate", "FILE", "a capture of the same transducers at the known --distance (one burst per code at t = 0, or a train with its period in its metadata): corrects the receiver latency per code, the mean for codes it lacks");
   p.option("--distance", "M", "the distance of the --calibrate capture, 0.001..1000 m");
+  p.option("--plot", "FILE.png", "draw the capture, the bandpass output and the bank's rho^2 per code with the detections");
   p.flag("--json", "machine-readable output");
   if (!p.parse(args)) return 0;
   const std::string path = p.positionals().at(0);
+  if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
   Capture cap = read_capture(path);
   const CaptureMeta& meta = cap.meta;
   const std::string meta_src = "capture metadata (" + (meta.source.empty() ? path : meta.source) + ")";
@@ -165,6 +227,7 @@ int cmd_decode(const Args& args) {
     if (cal) d.tof_s = cal->correct(d.code, d.tof_s);
     (d.rho_max >= min_rho ? dets : below).push_back(d);
   }
+  if (p.has("--plot")) plot_decode(*p.get("--plot"), scene, family, cap, fs, dets, below);
   const bool known = meta.code_sent && *meta.code_sent > 0;
   auto det_json = [&](const Detection& d) {
     nlohmann::json o = {{"code", d.code}, {"tof_s", d.tof_s}, {"distance_m", d.tof_s * c.value},

@@ -45,7 +45,12 @@ int cmd_generate(const Args& args) {
   warn_if_out_of_spec("generate", cfg);
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);
-  auto files = generate_hardware_files(design, p.get_or("--origin", *config));
+  std::map<std::string, std::string> files;
+  try {
+    files = generate_hardware_files(design, p.get_or("--origin", *config));
+  } catch (const InputError& e) {  // the system design's checks name system.* keys
+    throw InputError(locate_in_config(*config, e.what()));
+  }
   add_ip_package(files, design, p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl"),
                  std::string(build_info::kSourceDir) + "/hls", build_info::kVersion, "--rtl",
                  !p.has("--no-sources"));

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "model/base/atomic_file.hpp"
@@ -22,6 +23,7 @@
 #include "tool/commands.hpp"
 #include "tool/rotor_run.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/plot.hpp"
 #include "tool/rtl_scene_check.hpp"
 #include "tool/scene_run.hpp"
 
@@ -63,6 +65,45 @@ std::string num(double v, int prec = 9) {
 }
 
 nlohmann::json jnum(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+// simulate --plot: distance error against true distance per family (scripts/plot_simulate_error.py).
+// A measurement counts as decoded when the receiver detected the code that was sent; the others
+// (missed, misdecoded) are drawn apart at error 0, never as an error value.
+nlohmann::json error_plot_data(const Scene& scene, const SceneRun& run) {
+  nlohmann::json j;
+  j["title"] = "ranging simulate: " + scene.name + " (" + scene.receiver.precision + " receiver)";
+  j["families"] = nlohmann::json::array();
+  for (const auto& f : run.summaries) {
+    std::vector<double> true_m, err_m, failed_m;
+    std::map<double, std::vector<double>> by_distance;
+    std::size_t n = 0;
+    for (const auto& r : run.rows) {
+      if (r.family != f.family) continue;
+      ++n;
+      if (r.detected && (r.code_sent <= 0 || r.det.code == r.code_sent)) {
+        true_m.push_back(r.true_distance_m);
+        err_m.push_back(r.error_m);
+        by_distance[r.true_distance_m].push_back(r.error_m);
+      } else {
+        failed_m.push_back(r.true_distance_m);
+      }
+    }
+    std::vector<double> dist, mean, sd;
+    for (const auto& [x, es] : by_distance) {
+      double m = 0, v = 0;
+      for (double e : es) m += e;
+      m /= static_cast<double>(es.size());
+      for (double e : es) v += (e - m) * (e - m);
+      dist.push_back(x);
+      mean.push_back(m);
+      sd.push_back(es.size() > 1 ? std::sqrt(v / static_cast<double>(es.size() - 1)) : 0.0);
+    }
+    j["families"].push_back({{"family", f.family}, {"measurements", n}, {"detected", true_m.size()},
+                             {"true_m", true_m}, {"error_m", err_m}, {"failed_m", failed_m},
+                             {"distance_m", dist}, {"mean_error_m", mean}, {"std_error_m", sd}});
+  }
+  return j;
+}
 
 }  // namespace
 
@@ -189,9 +230,11 @@ int cmd_simulate(const Args& args) {
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
   p.option("--set", "KEY=VALUE", "override a key of the scene, a dotted YAML path (repeatable): noise.noise_v=0.01; receiver.config.KEY sets a key of its receiver configuration, e.g. receiver.config.correlator_fixed.chip_bits=18");
+  p.option("--plot", "FILE.png", "draw the distance error against the true distance, per family");
   p.flag("--quiet", "no progress bar");
   p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
+  if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
   Scene scene = load_scene(p.positionals().at(0), parse_overrides(p.values("--set")), p.has("--allow-out-of-spec"));
   warn_if_out_of_spec("simulate", scene.receiver.config);
   if (p.has("--precision")) {
@@ -211,6 +254,9 @@ int cmd_simulate(const Args& args) {
   if (rtl) scene.receiver.precision = "fixed";
   const std::string out = p.get_or("--out", "out/" + scene.name);
   const bool json = p.has("--json");
+  if (scene.geometry.type == "rotor" && p.has("--plot")) {
+    throw InputError("option --plot: not available for rotor scenes");
+  }
   if (scene.geometry.type == "rotor" && p.has("--write-captures")) {
     throw InputError("option --write-captures: not available for rotor scenes");
   }
@@ -251,6 +297,7 @@ int cmd_simulate(const Args& args) {
     summary["precision"] = "rtl";
     summary["rtl"] = rtl_check.run();
   }
+  if (p.has("--plot")) plot_with_script("option --plot", "scripts/plot_simulate_error.py", error_plot_data(scene, run), *p.get("--plot"));
   write_file_atomic(out + "/measurements.csv", measurements_csv(run, scene.speed()));
   write_file_atomic(out + "/summary.json", summary.dump(2) + "\n");
   write_effective_scene(scene, out);  // DIR/scene.yaml (+ config.yaml): re-run with `simulate DIR/scene.yaml`
@@ -287,6 +334,7 @@ int cmd_simulate(const Args& args) {
       if (!r["first_mismatch"].is_null()) text << "first mismatch: " << r["first_mismatch"].dump() << "\n";
     }
     text << "\nwrote " << out << "/measurements.csv, " << out << "/summary.json, " << out << "/scene.yaml"
+         << (p.has("--plot") ? ", " + *p.get("--plot") : std::string())
          << (p.has("--write-captures") ? ", " + out + "/captures/" : std::string()) << "\n";
     std::cout << text.str();
   }

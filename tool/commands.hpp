@@ -21,5 +21,6 @@ int cmd_wordlength(const Args& args);  // word-length optimization (cmd_wordleng
 int cmd_stability(const Args& args); // numerical stability report (cmd_stability.cpp)
 int cmd_frames(const Args& args);    // decode the board's UART frames (cmd_frames.cpp)
 int cmd_verify(const Args& args);    // the RTL of a configuration against the model (cmd_verify.cpp)
+int cmd_bitstream(const Args& args); // iCEBreaker bitstream of a configuration, --program (cmd_bitstream.cpp)
 
 }  // namespace ranging::tool

@@ -41,6 +41,8 @@ constexpr Subcommand kSubcommands[] = {
      ranging::tool::cmd_frames},
     {"verify", "verify the RTL of a configuration against the golden model, stage by stage",
      ranging::tool::cmd_verify},
+    {"bitstream", "build the iCEBreaker bitstream of a configuration (open flow) and program the board",
+     ranging::tool::cmd_bitstream},
 };
 
 void print_usage(std::ostream& os) {

@@ -110,6 +110,16 @@ ReceiverConfig parse_document(YAML::Node root, const std::string& origin, bool a
     r.get("frac_bits", d.frac_bits);
   });
   section(top, "hardware", [&](Reader& r) { r.get("clock_hz", cfg.clock_hz); });
+  section(top, "system", [&](Reader& r) {
+    auto& s = cfg.system;
+    r.get("speed_of_sound", s.speed_of_sound);
+    r.get("max_range_m", s.max_range_m);
+    r.get("baud", s.baud);
+    r.get("calibration_distance_m", s.calibration_distance_m);
+    r.get("time_w", s.time_w);
+    r.get("off_w", s.off_w);
+    r.get("c_frac", s.c_frac);
+  });
   top.finish();
   cfg.correlator.data_bits = cfg.bandpass.data_bits;
   cfg.correlator.data_frac = cfg.bandpass.data_frac;
@@ -139,6 +149,15 @@ ReceiverConfig default_receiver_config(const Overrides& overrides) {
 ReceiverConfig load_receiver_config(const std::string& path, const Overrides& overrides, bool allow_out_of_spec) {
   return parse_receiver_config(read_input_file(path, "configuration file", std::size_t{1} << 24), path, overrides,
                                allow_out_of_spec);
+}
+
+std::string locate_in_config(const std::string& path, const std::string& message) {
+  try {
+    const YAML::Node root = yaml::load(read_input_file(path, "configuration file", std::size_t{1} << 24), path);
+    return yaml::locate(root, path, message);
+  } catch (const std::exception&) {
+    return path + ": " + message;
+  }
 }
 
 std::string receiver_config_yaml(const ReceiverConfig& c) {
@@ -172,6 +191,10 @@ std::string receiver_config_yaml(const ReceiverConfig& c) {
   os << "detector:\n  threshold: " << d.threshold << "\n  holdoff: " << autoint(d.holdoff)
      << "\n  min_energy: " << d.min_energy << "\n  frac_bits: " << d.frac_bits << "\n";
   os << "hardware:\n  clock_hz: " << c.clock_hz << "\n";
+  const auto& s = c.system;
+  os << "system:\n  speed_of_sound: " << s.speed_of_sound << "\n  max_range_m: " << s.max_range_m
+     << "\n  baud: " << s.baud << "\n  calibration_distance_m: " << s.calibration_distance_m
+     << "\n  time_w: " << s.time_w << "\n  off_w: " << s.off_w << "\n  c_frac: " << s.c_frac << "\n";
   return os.str();
 }
 

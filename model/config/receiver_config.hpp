@@ -23,4 +23,9 @@ ReceiverConfig parse_receiver_config(const std::string& yaml_text, const std::st
 ReceiverConfig default_receiver_config(const Overrides& overrides);
 std::string receiver_config_yaml(const ReceiverConfig& cfg);
 
+// "path:line: message" when message starts with a key ("system.max_range_m: ...") that the
+// configuration file at path sets, else "path: message": for the checks made after loading
+// (the system design of generate and the bitstream, model/hw/hw_system.hpp).
+std::string locate_in_config(const std::string& path, const std::string& message);
+
 }  // namespace ranging

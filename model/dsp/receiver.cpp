@@ -35,6 +35,39 @@ void fit_decimation_to_chip(ReceiverConfig& cfg) {
   }
 }
 
+namespace {
+
+void validate_system(const ReceiverConfig& cfg) {
+  const SystemConfig& s = cfg.system;
+  require_in_range("system.speed_of_sound", s.speed_of_sound, 100.0, 10000.0);
+  require_in_range("system.max_range_m", s.max_range_m, 0.01, 100.0);
+  require_in_range("system.baud", s.baud, 1200.0, 12e6);
+  require_in_range("system.calibration_distance_m", s.calibration_distance_m, 0.01, 10.0);
+  // ARR_W = time_w + frac_bits + 1 <= 63: the arrival fits int64 in the model and the HLS.
+  require_in_range("system.time_w", s.time_w, 32, 46);
+  require_in_range("system.off_w", s.off_w, 16, 48);
+  // rtl/tof_distance.v: frac_bits + c_frac < 32 (the ToF and C registers are 32 bits).
+  require_in_range("system.c_frac", s.c_frac, 1, 31 - cfg.detector.frac_bits);
+  const double div = cfg.clock_hz / s.baud;
+  if (std::abs(div - std::round(div)) > 1e-9 * div || div < 2) {
+    std::ostringstream os;
+    os.precision(12);
+    os << "system.baud: hardware.clock_hz / baud = " << cfg.clock_hz << " / " << s.baud << " = " << div
+       << " must be an integer >= 2 (the UART divider)";
+    throw InputError(os.str());
+  }
+  const double c_reg = std::round(s.speed_of_sound / cfg.fs * 1e6 * std::ldexp(1.0, s.c_frac));
+  if (!(c_reg >= 1 && c_reg < 4294967296.0)) {
+    std::ostringstream os;
+    os.precision(12);
+    os << "system.c_frac: the speed register c / fs * 1e6 * 2^c_frac = " << c_reg
+       << " does not fit 32 bits (valid: >= 1 and < 2^32); lower system.c_frac";
+    throw InputError(os.str());
+  }
+}
+
+}  // namespace
+
 void validate(const ReceiverConfig& cfg) {
   require_in_range("signal.carrier_hz", cfg.carrier_hz, 1e3, 1e8);
   require_in_range("signal.fs", cfg.fs, 1e3, 1e9);
@@ -66,6 +99,7 @@ void validate(const ReceiverConfig& cfg) {
        << cfg.fs << "): the RTL takes one sample every clock_hz / fs clocks";
     throw InputError(os.str());
   }
+  validate_system(cfg);
   if (cfg.architecture != "baseband") {
     throw InputError("architecture: '" + cfg.architecture +
                      "' is not implemented by the fixed-point model; valid: baseband");

@@ -19,6 +19,21 @@
 
 namespace ranging {
 
+// The `system:` section (docs/configuration.md): the ranging system around the receiver
+// (rtl/ranging_system.v, model/hw/hw_system.hpp). The model of the receiver does not read it;
+// generate and the bitstream do (PERIOD_T, C_INIT, BAUD_DIV, OFFSETS, TIME_W of the RTL).
+struct SystemConfig {
+  double speed_of_sound = 340.0;        // m/s, loaded into the speed register at reset
+  double max_range_m = 1.0;             // L of eq. 3/4 (the paper: 100-1000 mm)
+  double baud = 1.5e6;                  // UART; hardware.clock_hz / baud is an integer >= 2
+  double calibration_distance_m = 0.1;  // latency calibration (a known distance, as the paper)
+  // Widths of the RTL (unsigned sample counters wrap after 2^time_w samples, the model's
+  // int64 indices do not: at 5 MS/s 40 bits is 2.5 days, 32 bits 14 minutes).
+  int time_w = 40;  // sample index of the bank, the detector and the scheduler
+  int off_w = 32;   // signed latency offset per code (frac_bits fraction bits)
+  int c_frac = 16;  // fraction bits of the speed register (um per sample); frac_bits + c_frac < 32
+};
+
 struct ReceiverConfig {
   std::string name = "default";
   std::string family = "Gold4";          // code family (ranging codes --list)
@@ -46,6 +61,7 @@ struct ReceiverConfig {
   // hardware.clock_hz: the system clock the generated RTL is scheduled for (the iCEBreaker's
   // PLL makes it from 12 MHz); clock_hz / fs clocks per input sample, an integer.
   double clock_hz = 30e6;
+  SystemConfig system;
   // Study option, never read from or written to YAML: design_receiver refuses a design whose
   // quantized filter is unstable or out of spec (model/dsp/stability.hpp) unless it is set
   // (the tools' --allow-out-of-spec).

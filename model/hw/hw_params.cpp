@@ -113,7 +113,7 @@ std::vector<HwModuleParams> hardware_parameters(const ReceiverDesign& d) {
                 scalar("SAMPLE_CYCLES", c.sample_cycles())};
   out.push_back(sos);
 
-  const int time_w = 40;
+  const int time_w = c.system.time_w;  // system.time_w
   HwModuleParams bank{"correlator_bank", {}};
   std::vector<std::int64_t> code_bits;  // one element per code: bit m = chip m
   std::vector<std::int64_t> chips_flat;

@@ -9,6 +9,7 @@
 #include "model/sim/channel.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
+#include "model/hw/hw_emit.hpp"
 #include "model/hw/hw_params.hpp"
 
 namespace ranging {
@@ -36,9 +37,11 @@ std::int64_t module_value(const std::vector<HwModuleParams>& mods, const std::st
 }  // namespace
 
 std::uint32_t speed_register(double c, double fs, int c_frac) {
-  require_in_range("speed_of_sound", c, 100.0, 10000.0);
+  require_in_range("system.speed_of_sound", c, 100.0, 10000.0);
   const double v = std::round(c / fs * 1e6 * std::ldexp(1.0, c_frac));
-  if (!(v >= 1 && v < 4294967296.0)) throw InputError("speed_of_sound: register out of 32 bits");
+  if (!(v >= 1 && v < 4294967296.0)) {
+    throw InputError("system.c_frac: the speed register c / fs * 1e6 * 2^c_frac does not fit 32 bits");
+  }
   return static_cast<std::uint32_t>(v);
 }
 
@@ -65,13 +68,23 @@ Ice40Pll ice40_pll(double f_in, double f_out) {
   throw InputError(os.str());
 }
 
+SystemOptions system_options(const ReceiverConfig& c) {
+  SystemOptions o;
+  static_cast<SystemConfig&>(o) = c.system;
+  return o;
+}
+
+SystemDesign system_design(const ReceiverDesign& d) { return system_design(d, system_options(d.config)); }
+
 SystemDesign system_design(const ReceiverDesign& d, const SystemOptions& options) {
   SystemOptions opt = options;
   if (opt.clk_hz == 0) opt.clk_hz = d.config.clock_hz;
   require_in_range("clk_hz", opt.clk_hz, 1e6, 500e6);
-  require_in_range("max_range_m", opt.max_range_m, 0.01, 100.0);
-  require_in_range("baud", opt.baud, 1200.0, 12e6);
-  require_in_range("calibration_distance_m", opt.calibration_distance_m, 0.01, 10.0);
+  require_in_range("system.max_range_m", opt.max_range_m, 0.01, 100.0);
+  require_in_range("system.baud", opt.baud, 1200.0, 12e6);
+  require_in_range("system.calibration_distance_m", opt.calibration_distance_m, 0.01, 10.0);
+  require_in_range("system.off_w", opt.off_w, 16, 48);
+  require_in_range("system.c_frac", opt.c_frac, 1, 31 - d.config.detector.frac_bits);
   const ReceiverConfig& c = d.config;
   const auto mods = hardware_parameters(d);
   SystemDesign s;
@@ -81,7 +94,7 @@ SystemDesign system_design(const ReceiverDesign& d, const SystemOptions& options
   s.max_range_m = opt.max_range_m;
   s.baud = opt.baud;
   s.clk_div = exact_divider("clk_hz / fs", opt.clk_hz, c.fs);
-  s.baud_div = exact_divider("clk_hz / baud", opt.clk_hz, opt.baud);
+  s.baud_div = exact_divider("system.baud: clk_hz / baud", opt.clk_hz, opt.baud);
   s.codes = static_cast<int>(d.family.codes.size());
   s.chips = d.family.length;
   s.spc = c.chip_samples();
@@ -97,13 +110,16 @@ SystemDesign system_design(const ReceiverDesign& d, const SystemOptions& options
   const int burst = s.chips * s.spc;
   const PeakDetectorFixed det(c.detector, d.layout, c.correlator);
   if (s.period_t < burst || s.period_t < det.holdoff()) {
-    throw InputError("max_range_m: the burst period " + std::to_string(s.period_t) +
-                     " samples is shorter than a burst or the detector holdoff");
+    throw InputError("system.max_range_m: the burst period " + std::to_string(s.period_t) +
+                     " samples is shorter than a burst (" + std::to_string(burst) + ") or the detector holdoff (" +
+                     std::to_string(det.holdoff()) + ")");
   }
   s.code_w = static_cast<int>(module_value(mods, "peak_detector", "CODE_W"));
   s.time_w = static_cast<int>(module_value(mods, "peak_detector", "TIME_W"));
   s.frac_w = static_cast<int>(module_value(mods, "peak_detector", "FRAC_W"));
   s.score_w = static_cast<int>(module_value(mods, "peak_detector", "SCORE_W"));
+  s.off_w = opt.off_w;
+  s.c_frac = opt.c_frac;
   s.c_init = speed_register(opt.speed_of_sound, c.fs, s.c_frac);
   s.led_hold = static_cast<std::int64_t>(opt.clk_hz / 20);
 
@@ -133,10 +149,16 @@ SystemDesign system_design(const ReceiverDesign& d, const SystemOptions& options
     }
     if (!ev) ev = rx.flush_raw();
     if (!ev || ev->code != j + 1) {
-      throw InputError("calibration: code " + std::to_string(j + 1) +
-                       " is not decoded at calibration_distance_m; check detector.threshold");
+      throw InputError("system.calibration_distance_m: code " + std::to_string(j + 1) +
+                       " is not decoded at the calibration distance; check detector.threshold");
     }
-    s.offsets.push_back(ev->arrival - flight_q);
+    const std::int64_t off = ev->arrival - flight_q;
+    const std::int64_t lim = std::int64_t{1} << (s.off_w - 1);
+    if (off < -lim || off >= lim) {
+      throw InputError("system.off_w: the latency offset " + std::to_string(off) + " of code " + std::to_string(j + 1) +
+                       " does not fit " + std::to_string(s.off_w) + " signed bits; valid range is [16, 48]");
+    }
+    s.offsets.push_back(off);
   }
   return s;
 }
@@ -216,12 +238,10 @@ std::vector<std::int8_t> system_drive(const ReceiverDesign& d, const SystemDesig
 }
 
 std::map<std::string, std::string> generate_system_files(const ReceiverDesign& design,
-                                                         const std::string& origin,
-                                                         const SystemOptions& opt) {
-  const SystemDesign s = system_design(design, opt);
-  // Scalars as sized 32-bit literals (Verilator -Wall: WIDTHCONCAT on unsized parameter values).
-  const auto d32 = [](auto v) { return "32'd" + std::to_string(v); };
-  const std::vector<std::pair<std::string, std::string>> params = {
+                                                         const std::string& origin) {
+  const SystemDesign s = system_design(design);
+  const auto d32 = [](std::int64_t v) { return emit::sized32(v); };
+  const emit::VerilogParams params = {
       {"CLK_DIV", d32(s.clk_div)},
       {"ADC_W", d32(design.config.bandpass.input_bits)},
       {"ADC_OFFSET_BINARY", d32(1)},
@@ -241,8 +261,7 @@ std::map<std::string, std::string> generate_system_files(const ReceiverDesign& d
       {"C_INIT", d32(s.c_init)},
       {"BAUD_DIV", d32(s.baud_div)},
       {"LED_HOLD", d32(s.led_hold)}};
-  const std::string head = "// Generated by `ranging generate` (model/hw/hw_system.cpp) from " + origin +
-                           ". Do not edit by hand:\n// change the configuration and regenerate (docs/bitstream.md).\n";
+  const std::string head = emit::banner("//", origin, "docs/bitstream.md", "model/hw/hw_system.cpp");
   std::ostringstream v;
   v << head
     << "//\n// ranging_system_top: rtl/ranging_system.v with the parameters of this configuration.\n"
@@ -258,16 +277,12 @@ std::map<std::string, std::string> generate_system_files(const ReceiverDesign& d
     << "  output wire uart_tx, led_meas, led_error,\n"
     << "  output wire sample_tick, meas_valid\n);\n"
     << "  ranging_system #(\n";
-  for (std::size_t i = 0; i < params.size(); ++i) {
-    v << "    ." << params[i].first << "(" << params[i].second << ")" << (i + 1 < params.size() ? ",\n" : "\n");
-  }
+  v << emit::instance_params(params);
   v << "  ) u_system (\n"
     << "    .clk(clk), .rst(rst), .adc_clk(adc_clk), .adc_data(adc_data),\n"
     << "    .hb_p(hb_p), .hb_n(hb_n), .tx_active(tx_active), .c_wr(c_wr), .c_value(c_value),\n"
     << "    .uart_tx(uart_tx), .led_meas(led_meas), .led_error(led_error),\n"
     << "    .sample_tick(sample_tick), .meas_valid(meas_valid)\n  );\nendmodule\n\n`default_nettype wire\n";
-  std::ostringstream vc;
-  for (const auto& [k, val] : params) vc << "-G" << k << "=" << val << "\n";
   nlohmann::json j;
   j["generated_from"] = origin;
   j["clk_hz"] = s.clk_hz;
@@ -296,8 +311,8 @@ std::map<std::string, std::string> generate_system_files(const ReceiverDesign& d
   std::map<std::string, std::string> files;
   files["rtl/ice40_pll.vh"] = vh.str();
   files["rtl/ranging_system_top.v"] = v.str();
-  files["rtl/ranging_system.vc"] = vc.str();
-  files["system.json"] = j.dump(2) + "\n";
+  files["rtl/ranging_system.vc"] = emit::vc_file(params);
+  files["system.json"] = emit::json_file(j);
   return files;
 }
 

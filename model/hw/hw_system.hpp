@@ -12,14 +12,12 @@
 
 namespace ranging {
 
-// Board and deployment choices that the receiver configuration does not carry.
-struct SystemOptions {
-  double clk_hz = 0;              // system clock; 0: the configuration's hardware.clock_hz
-  double max_range_m = 1.0;       // L of eq. 3/4 (the paper: 100-1000 mm)
-  double speed_of_sound = 340.0;  // m/s, loaded into the speed register at reset
-  double baud = 1.5e6;            // UART
-  double calibration_distance_m = 0.1;  // latency calibration (a known distance, as the paper)
+// The configuration's `system:` section (SystemConfig, model/dsp/receiver.hpp) and the system
+// clock; system_options(config) is what generate and the bitstream use.
+struct SystemOptions : SystemConfig {
+  double clk_hz = 0;  // system clock; 0: the configuration's hardware.clock_hz
 };
+SystemOptions system_options(const ReceiverConfig& config);
 
 struct SystemDesign {
   int clk_div = 0;        // clocks per full-rate sample (f_clk / fs, exact integer)
@@ -37,9 +35,11 @@ struct SystemDesign {
   double measurement_rate_hz() const { return fs / period_t; }
 };
 
-// Throws InputError naming the option when the clock is not an integer multiple of fs, the
-// baud rate is not an integer divider, or the period cannot hold a burst.
-SystemDesign system_design(const ReceiverDesign& design, const SystemOptions& opt = {});
+// Throws InputError naming the key (system.*) when the clock is not an integer multiple of fs,
+// the baud rate is not an integer divider, the period cannot hold a burst, a latency offset
+// does not fit system.off_w bits or the calibration burst is not decoded.
+SystemDesign system_design(const ReceiverDesign& design);  // system_options(design.config)
+SystemDesign system_design(const ReceiverDesign& design, const SystemOptions& opt);
 
 // Speed of sound (m/s) -> the tof_distance C register (um per sample, c_frac fraction bits).
 std::uint32_t speed_register(double speed_of_sound, double fs, int c_frac);
@@ -85,7 +85,6 @@ Ice40Pll ice40_pll(double f_in, double f_out);
 // Generated files (relative to the generator's output folder): rtl/ranging_system_top.v,
 // rtl/ranging_system.vc, rtl/ice40_pll.vh (the iCEBreaker PLL: 12 MHz -> clk_hz), system.json.
 std::map<std::string, std::string> generate_system_files(const ReceiverDesign& design,
-                                                         const std::string& origin,
-                                                         const SystemOptions& opt = {});
+                                                         const std::string& origin);
 
 }  // namespace ranging

@@ -1,0 +1,238 @@
+// `ranging bitstream`: the iCEBreaker bitstream of any receiver configuration (docs/bitstream.md).
+// The configuration is loaded and its system designed here first (every bad key is reported with
+// file:line before minutes of synthesis), then scripts/build_bitstream.sh runs the open flow
+// (ranging generate -> yosys -> nextpnr-ice40 over --seeds seeds, --jobs at a time -> icepack ->
+// icetime) into --out; its progress goes to stderr, the summary (OUT/results/bitstream.{json,md})
+// to stdout on success.
+//
+// --program writes the bitstream into the board's flash with iceprog (fpga-icestorm) or, without
+// it, openFPGALoader. The board is probed before the flow starts (iceprog -t reads the flash ID;
+// openFPGALoader --detect): with no programmer installed or no board attached, the command fails
+// at once with exit status 2 (a request this machine cannot serve, like bad input) and builds
+// nothing. --bin FILE programs an existing bitstream without building one.
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "model/base/error.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/hw/hw_params.hpp"
+#include "model/hw/hw_system.hpp"
+#include "tool/build_info.hpp"
+#include "tool/cli.hpp"
+#include "tool/commands.hpp"
+#include "tool/guard.hpp"
+#include "tool/rtl_runner.hpp"
+
+namespace ranging::tool {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+int exit_status(int st) { return (st != -1 && WIFEXITED(st)) ? WEXITSTATUS(st) : -1; }
+
+// Runs cmd with stdout and stderr captured; returns the exit status.
+int capture(const std::string& cmd, std::string& output) {
+  FILE* pipe = ::popen((cmd + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return -1;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) output.append(buf, n);
+  return exit_status(::pclose(pipe));
+}
+
+bool on_path(const std::string& tool) {
+  std::string ignored;
+  return capture("command -v " + quote(tool), ignored) == 0;
+}
+
+std::string last_line(const std::string& text) {
+  std::istringstream is(text);
+  std::string line, last;
+  while (std::getline(is, line)) {
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  }
+  return last.empty() ? "(no output)" : last;
+}
+
+struct Programmer {
+  std::string name;                  // iceprog or openFPGALoader
+  std::string probe, write_prefix;   // shell commands
+};
+
+// The programmer to use and a probe that the board answers; InputError (exit 2) otherwise.
+Programmer find_board() {
+  Programmer p;
+  if (on_path("iceprog")) {
+    p = {"iceprog", "iceprog -t", "iceprog "};
+  } else if (on_path("openFPGALoader")) {
+    p = {"openFPGALoader", "openFPGALoader -b ice40_generic --detect", "openFPGALoader -b ice40_generic -f "};
+  } else {
+    throw InputError("option --program: no programmer found: install iceprog (Debian package fpga-icestorm) or "
+                     "openFPGALoader (scripts/install-deps.sh --hardware installs fpga-icestorm)");
+  }
+  std::string out;
+  if (capture(p.probe, out) != 0) {
+    throw InputError("option --program: no iCEBreaker board answers (`" + p.probe + "`: " + last_line(out) +
+                     "); connect the board by USB (and check its permissions), or build without --program");
+  }
+  return p;
+}
+
+void program(const Programmer& p, const std::string& bin) {
+  std::cerr << "[bitstream] " << p.write_prefix << bin << "\n";
+  std::string out;
+  if (capture(p.write_prefix + quote(bin), out) != 0) {
+    throw InputError("option --program: `" + p.write_prefix + bin + "` failed: " + last_line(out));
+  }
+}
+
+fs::path self_exe() {
+  std::error_code ec;
+  fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("bitstream: cannot find the ranging executable (/proc/self/exe)");
+  return p;
+}
+
+}  // namespace
+
+int cmd_bitstream(const Args& args) {
+  cli::Parser p("ranging bitstream",
+                "Build the iCEBreaker (iCE40UP5K-SG48) bitstream of the ranging system for a receiver\n"
+                "configuration with the open flow (generate, yosys synth_ice40, nextpnr-ice40, icepack,\n"
+                "icetime: scripts/build_bitstream.sh), and optionally program the board. The netlists,\n"
+                "logs, the .bin and the summary (results/bitstream.json and .md) go into --out; progress\n"
+                "goes to stderr, the summary to stdout.\n"
+                "Exit status: 0 built (and programmed), 1 --check and a target missed, 2 bad input, a\n"
+                "missing tool, or --program with no programmer installed or no board attached (checked\n"
+                "before anything is built).");
+  p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md); its system: section sets clock, UART, speed of sound");
+  p.option("--set", "KEY=VALUE", "override a key of the configuration (repeatable), as in ranging generate");
+  p.option("--board", "NAME", "target board; valid: icebreaker", "icebreaker");
+  p.option("--seeds", "N", "place and route with nextpnr seeds 1..N and keep the fastest (1-99)", "1");
+  p.option("--jobs", "N", "seeds placed and routed at the same time (1-99)", "1");
+  p.option("--out", "DIR", "work and report folder (default: $TMPDIR/ranging-bitstream-UID-NAME)");
+  p.flag("--check", "exit 1 unless the targets of docs/bitstream.md are met (LUT4, SB_MAC16, EBR, Fmax)");
+  p.flag("--estimates", "also estimate ECP5 and Xilinx 7 resources of this configuration with yosys");
+  p.flag("--program", "write the bitstream into the board's flash (iceprog or openFPGALoader)");
+  p.option("--bin", "FILE", "with --program: program this bitstream, build nothing");
+  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
+  if (!p.parse(args)) return 0;
+  const std::string board = p.get_or("--board", "icebreaker");
+  if (board != "icebreaker") throw InputError("option --board: '" + board + "' is not supported; valid: icebreaker");
+  const long long seeds = p.integer("--seeds", 1, 1, 99);
+  const long long jobs = p.integer("--jobs", 1, 1, 99);
+  const bool do_program = p.has("--program");
+
+  if (p.has("--bin")) {
+    if (!do_program) throw InputError("option --bin: only with --program (it names the bitstream to program)");
+    if (p.has("--config") || p.has("--set")) throw InputError("option --bin: programs an existing bitstream; give no --config");
+    const std::string bin = *p.get("--bin");
+    std::error_code ec;
+    if (!fs::is_regular_file(bin, ec)) throw InputError("option --bin: no file '" + bin + "'");
+    const Programmer prog = find_board();
+    program(prog, bin);
+    std::cout << "programmed " << bin << " with " << prog.name << "\n";
+    return 0;
+  }
+
+  const auto config = p.get("--config");
+  if (!config) throw InputError("option --config is required");
+  const Overrides overrides = parse_overrides(p.values("--set"));
+  const ReceiverConfig cfg = load_receiver_config(*config, overrides, p.has("--allow-out-of-spec"));
+  warn_if_out_of_spec("bitstream", cfg);
+  check_generatable(cfg);
+  try {  // the system design (period, UART divider, calibration) before minutes of synthesis
+    (void)system_design(design_receiver(cfg));
+  } catch (const InputError& e) {
+    throw InputError(locate_in_config(*config, e.what()));
+  }
+  const fs::path out = fs::absolute(p.get_or("--out", default_work_dir("bitstream", cfg.name).string()));
+  {
+    std::error_code ec;
+    if (fs::exists(out, ec) && !fs::is_directory(out, ec)) {
+      throw InputError("option --out: '" + out.string() + "' exists and is not a folder; expected a folder");
+    }
+    const fs::path src = fs::weakly_canonical(build_info::kSourceDir);
+    const fs::path o = fs::weakly_canonical(out);
+    const auto rel = o.lexically_relative(src);
+    if (!rel.empty() && *rel.begin() != ".." && !p.has("--out")) {
+      throw InputError("option --out: the default '" + out.string() + "' is inside the source tree; give --out");
+    }
+  }
+  Programmer prog;
+  if (do_program) prog = find_board();  // fail before the flow, not after it
+
+  fs::create_directories(out);
+  std::string config_path = fs::absolute(*config).string();
+  if (!overrides.empty()) {  // the effective configuration, as generate --set writes it
+    config_path = (out / "config.yaml").string();
+    std::ofstream f(config_path);
+    f << receiver_config_yaml(cfg);
+    if (!f) throw InputError("option --out: cannot write " + config_path);
+  }
+  const fs::path results = out / "results";
+  std::error_code ec;
+  fs::remove(results / "bitstream.json", ec);
+  const std::string script = std::string(build_info::kSourceDir) + "/scripts/build_bitstream.sh";
+  std::string cmd = quote(script) + " --config " + quote(config_path) + " --ranging " + quote(self_exe().string()) +
+                    " --out " + quote(out.string()) + " --results " + quote(results.string()) + " --seeds " +
+                    std::to_string(seeds) + " --jobs " + std::to_string(jobs) + " --no-large";
+  if (!p.has("--estimates")) cmd += " --no-others";
+  if (p.has("--check")) cmd += " --check";
+  cmd += " 1>&2";  // progress and the script's summary on stderr; ours on stdout
+  const int rc = exit_status(std::system(cmd.c_str()));
+  if (rc == 2 || rc < 0 || !fs::exists(results / "bitstream.json")) {
+    throw InputError("the flow failed (scripts/build_bitstream.sh exit status " + std::to_string(rc) +
+                     "; its message is above, logs in " + out.string() + ")");
+  }
+  nlohmann::json summary;
+  {
+    std::ifstream f(results / "bitstream.json");
+    summary = nlohmann::json::parse(f);
+  }
+  const auto& ic = summary["ice40"];
+  const bool met = summary.value("targets_met", false);
+  if (rc == 1) {
+    std::cerr << "ranging bitstream: targets not met:";
+    for (const auto& f : summary["target_failures"]) std::cerr << "\n  " << f.get<std::string>();
+    std::cerr << "\n(summary: " << (results / "bitstream.md").string() << ")\n";
+    return 1;
+  }
+  if (rc != 0) throw InputError("scripts/build_bitstream.sh exited with status " + std::to_string(rc));
+  const bool routed = ic.value("placed_and_routed", false);
+  if (do_program && !routed) {
+    throw InputError("option --program: the design was not placed and routed (" +
+                     ic.value("nextpnr_error", std::string("nextpnr failed")) + "): nothing to program");
+  }
+  const fs::path bin = out / "ranging_icebreaker.bin";
+  if (do_program) program(prog, bin.string());
+  std::cout << "configuration " << cfg.name << " (" << *config << "), board " << board << "\n"
+            << "LUT4 " << ic.value("lut4", 0) << " / 5280, SB_MAC16 " << ic.value("sb_mac16", 0) << " / 8, EBR "
+            << ic.value("ebr", 0) << " / 30\n";
+  if (routed) {
+    std::cout << "placed and routed: Fmax " << ic.value("fmax_mhz", 0.0) << " MHz at "
+              << ic.value("required_clock_mhz", 0.0) << " MHz required (seed " << ic.value("nextpnr_seed", 0)
+              << " of " << seeds << ")\nbitstream " << bin.string() << "\n";
+  } else {
+    std::cout << "not placed and routed: " << ic.value("nextpnr_error", std::string("nextpnr failed")) << "\n";
+  }
+  std::cout << "targets " << (met ? "met" : "not met") << "; summary " << (results / "bitstream.md").string() << "\n";
+  if (do_program) std::cout << "programmed with " << prog.name << "\n";
+  return 0;
+}
+
+}  // namespace ranging::tool
