@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <cstdio>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -88,7 +89,13 @@ fs::path default_work_dir(const std::string& what, const std::string& config_nam
   const fs::path base = (t && *t) ? fs::path(t) : fs::path("/tmp");
   std::string safe;
   for (char c : config_name) safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
-  return base / ("ranging-" + what + "-" + std::to_string(::getuid()) + "-" + safe);
+  // The project's source folder is part of the key: two checkouts (or installs) never share a
+  // Verilator build whose make rules name the other's testbench sources.
+  std::uint32_t h = 2166136261u;  // FNV-1a of kSourceDir
+  for (char c : std::string(build_info::kSourceDir)) h = (h ^ static_cast<unsigned char>(c)) * 16777619u;
+  char tag[9];
+  std::snprintf(tag, sizeof tag, "%08x", h);
+  return base / ("ranging-" + what + "-" + std::to_string(::getuid()) + "-" + safe + "-" + tag);
 }
 
 RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& options)
