@@ -15,9 +15,19 @@
 #include <utility>
 #include <vector>
 
+#include "model/config/receiver_config.hpp"
 #include "model/hw/hw_params.hpp"
 
 namespace ranging::tb {
+
+#ifdef RANGING_CONFIG
+// The design of the configuration this testbench is built for (RANGING_CONFIG, a YAML path set
+// per target by tb/CMakeLists.txt): what the Verilated module's parameters were generated from.
+inline const ReceiverDesign& configured_design() {
+  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
+  return d;
+}
+#endif
 
 // (NAME, Verilog value) in the order of the .vc: scalars as decimal, tables packed (element i
 // at [i*bits +: bits]).

@@ -35,10 +35,7 @@ namespace {
 using namespace ranging;
 using Dut = Vbandpass_sos;
 
-const ReceiverDesign& default_design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
+const ReceiverDesign& default_design() { return tb::configured_design(); }
 
 std::uint64_t g_total_compared = 0;
 

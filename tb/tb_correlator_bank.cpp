@@ -38,10 +38,7 @@ namespace {
 
 using namespace ranging;
 
-const ReceiverDesign& design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
+const ReceiverDesign& design() { return tb::configured_design(); }
 
 struct Output {
   std::vector<std::uint64_t> q;

@@ -37,6 +37,7 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-parameter"
 #include "Vpeak_detector.h"
+#include "tb/generated_params.hpp"
 #include "tb/verilator_harness.hpp"
 #pragma GCC diagnostic pop
 
@@ -54,10 +55,7 @@ std::string event_mismatch(std::size_t n, const char* what, const ranging::Event
 
 using namespace ranging;
 
-const ReceiverDesign& design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
+const ReceiverDesign& design() { return tb::configured_design(); }
 
 // One bank output (a group): Q_j of every code, E, n. The detector receives it as CODES beats.
 struct Beat {
@@ -319,7 +317,6 @@ struct PacedResult {
 // from a group's first beat to s_ready high again after its last beat (the group's whole time).
 PacedResult run_paced(DetSim& sim, const std::vector<Beat>& beats, const std::vector<EventFixed>& expected,
                       std::uint64_t period) {
-  const auto& d = design();
   PacedResult r;
   auto fail = [&](const std::string& m) {
     ++r.mismatches;

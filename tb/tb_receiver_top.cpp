@@ -17,16 +17,14 @@
 #include "model/sim/channel.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/receiver.hpp"
+#include "tb/generated_params.hpp"
 #include "tb/verilator_harness.hpp"
 
 using namespace ranging;
 
 namespace {
 
-const ReceiverDesign& design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
+const ReceiverDesign& design() { return tb::configured_design(); }
 
 std::uint64_t g_compared_samples = 0;
 
