@@ -253,8 +253,9 @@ nlohmann::json write_rho_d_csv(SceneSimulator& sim, const Scene& scene, const st
 std::vector<std::string> draw_figures(const Scene& scene, const std::string& stem, const std::string& fig13_family) {
   namespace fs = std::filesystem;
   std::vector<std::string> figures;
-  // The script ships with the sources: next to this file's tree, else under the working directory.
-  std::string script = (fs::path(__FILE__).parent_path().parent_path() / "scripts/plot_section4.py").string();
+  // The script ships with the sources (the tree this tool was built from), else under the working
+  // directory. (__FILE__ is relative to the build folder under ccache's base_dir, so not used.)
+  std::string script = std::string(build_info::kSourceDir) + "/scripts/plot_section4.py";
   if (!fs::exists(script)) script = "scripts/plot_section4.py";
   const std::string cmd = "/usr/bin/python3 '" + script + "' '" + stem + "' '" + fig13_family + "' > /dev/null";
   if (std::system(cmd.c_str()) != 0) {
