@@ -3,8 +3,6 @@
 //   build/tb/bench_receiver_top [CPU seconds per measurement]
 // Rates are samples per second of this thread's CPU time, so a busy machine does not scale
 // them down (wall time would).
-#include <verilated.h>
-
 #include <ctime>
 #include <cstdio>
 #include <cstdlib>
@@ -17,6 +15,7 @@
 #include "model/sim/channel.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/receiver.hpp"
+#include "tb/verilator_harness.hpp"
 
 using namespace ranging;
 
@@ -93,27 +92,21 @@ int main(int argc, char** argv) {
   const double model_rate = block_rate;
 
   // Verilated RTL, samples offered back to back, events always accepted.
-  VerilatedContext ctx;
-  Vreceiver_top dut(&ctx);
+  tb::Harness<Vreceiver_top> h("bench_receiver_top");  // tb/verilator_harness.hpp (no trace compiled in)
+  Vreceiver_top& dut = h.top();
   std::uint64_t rtl_samples = 0, rtl_events = 0, cycles = 0;
   const double t1 = cpu_seconds();
   while (cpu_seconds() - t1 < budget) {
-    dut.rst = 1;
-    for (int i = 0; i < 4; ++i) {
-      dut.clk = 0; dut.eval(); dut.clk = 1; dut.eval();
-    }
-    dut.rst = 0;
+    h.reset(4);
     dut.m_axis_tready = 1;
     std::size_t next = 0;
     while (next < x.size()) {
       dut.s_axis_tvalid = 1;
       dut.s_axis_tdata = static_cast<std::uint16_t>(x[next]) & 0xfff;
-      dut.clk = 0;
-      dut.eval();
+      h.settle();
       if (dut.s_axis_tready) ++next;
       rtl_events += dut.m_axis_tvalid;
-      dut.clk = 1;
-      dut.eval();
+      h.tick();
       ++cycles;
     }
     rtl_samples += x.size();
@@ -135,6 +128,5 @@ int main(int argc, char** argv) {
   std::printf("  events per pass of %zu samples: model %zu, RTL %.1f\n", x.size(), ev_block.size(),
               static_cast<double>(rtl_events) * x.size() / rtl_samples);
   (void)model_events;
-  dut.final();
   return 0;
 }

@@ -27,6 +27,7 @@
 #include "model/dsp/excitation.hpp"
 #include "model/hw/hw_params.hpp"
 #include "model/dsp/receiver.hpp"
+#include "tb/generated_params.hpp"
 #include "tb/verilator_harness.hpp"
 
 namespace {
@@ -34,10 +35,7 @@ namespace {
 using namespace ranging;
 using Dut = Vbandpass_sos;
 
-const ReceiverDesign& default_design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
+const ReceiverDesign& default_design() { return tb::configured_design(); }
 
 std::uint64_t g_total_compared = 0;
 
@@ -255,7 +253,7 @@ class SosBench {
   }
 
  private:
-  const Dut& h_top() const { return const_cast<tb::Harness<Dut>&>(h_).top(); }
+  const Dut& h_top() const { return h_.top(); }
 
   void check(std::size_t i, std::int64_t y, const std::vector<std::int64_t>& s) {
     ++compared_;
@@ -294,6 +292,15 @@ void report(const char* what, const SosBench& b) {
             << " mismatches\n";
 }
 
+// Prints the bench's counts and checks them: every offered sample compared, no mismatch, no
+// handshake violation.
+void expect_clean(const char* what, const SosBench& b, std::uint64_t offered) {
+  report(what, b);
+  EXPECT_EQ(b.compared(), offered) << what;
+  EXPECT_EQ(b.mismatches(), 0u) << what;
+  EXPECT_EQ(b.protocol_errors(), 0u) << what;
+}
+
 // ---- helpers for the external tools ---------------------------------------------------------
 
 struct CmdResult {
@@ -313,19 +320,10 @@ CmdResult run(const std::string& cmd) {
   return r;
 }
 
-using ParamList = std::vector<std::pair<std::string, std::string>>;
+using tb::ParamList;
 
-ParamList read_vc(const std::string& path) {
-  ParamList out;
-  std::ifstream f(path);
-  std::string line;
-  while (std::getline(f, line)) {
-    if (line.rfind("-G", 0) != 0) continue;
-    const auto eq = line.find('=');
-    out.emplace_back(line.substr(2, eq - 2), line.substr(eq + 1));
-  }
-  return out;
-}
+// What the generator writes into generated/<config>/rtl/bandpass_sos.vc (tb/generated_params.hpp).
+ParamList generated_params() { return tb::verilog_params(tb::generated_module(default_design(), "bandpass_sos")); }
 
 int rounding_code(Rounding r) { return r == Rounding::Truncate ? 0 : r == Rounding::RoundHalfUp ? 1 : 2; }
 
@@ -348,7 +346,6 @@ ParamList params_for(const BandpassFixed& m, int sample_cycles) {
 }
 
 std::string rtl_path() { return std::string(RANGING_SOURCE_DIR) + "/rtl/bandpass_sos.v"; }
-std::string vc_path() { return std::string(RANGING_GENERATED_DIR) + "/rtl/bandpass_sos.vc"; }
 
 CmdResult lint(const ParamList& params) {
   std::string cmd = std::string(RANGING_VERILATOR_BIN) + " --lint-only -Wall --top-module bandpass_sos";
@@ -452,12 +449,21 @@ TEST(BandpassSosRtl, GeneratedParametersAreTheModels) {
   // The Verilated module gets the generator's .vc; the benches below build the model from the
   // same configuration. Both must describe the same filter for the comparison to mean anything.
   const BandpassFixed m(default_design().filter, default_design().config.bandpass);
-  const ParamList vc = read_vc(vc_path());
+  const ParamList vc = generated_params();
   const ParamList mine = params_for(m, default_design().config.sample_cycles());
   ASSERT_EQ(vc.size(), mine.size());
   for (std::size_t i = 0; i < vc.size(); ++i) {
     EXPECT_EQ(vc[i].first, mine[i].first);
     EXPECT_EQ(vc[i].second, mine[i].second) << vc[i].first;
+  }
+  // The committed manifest.json (next to the .vc the Verilated module was built with) holds
+  // the same values.
+  const auto manifest = tb::manifest_module(std::string(RANGING_GENERATED_DIR) + "/manifest.json", "bandpass_sos");
+  const HwModuleParams gen = tb::generated_module(default_design(), "bandpass_sos");
+  ASSERT_EQ(manifest.size(), gen.params.size());
+  for (const auto& p : gen.params) {
+    ASSERT_EQ(manifest.count(p.name), 1u) << p.name;
+    EXPECT_EQ(manifest.at(p.name), p.elements) << p.name;
   }
 }
 
@@ -489,10 +495,7 @@ TEST(BandpassSosRtl, CodedEchoesBitExact) {
       offered += x.size();
     }
   }
-  report("coded echoes (M1, Gold4 at 100/550/1000 mm with and without noise; M2-M4, Gold1-7 at 100 mm)", b);
-  EXPECT_EQ(b.compared(), offered);
-  EXPECT_EQ(b.mismatches(), 0u);
-  EXPECT_EQ(b.protocol_errors(), 0u);
+  expect_clean("coded echoes (M1, Gold4 at 100/550/1000 mm with and without noise; M2-M4, Gold1-7 at 100 mm)", b, offered);
 }
 
 TEST(BandpassSosRtl, WorstCaseNoiseStepsImpulsesBitExact) {
@@ -518,10 +521,7 @@ TEST(BandpassSosRtl, WorstCaseNoiseStepsImpulsesBitExact) {
   b.stream(s, 1.0, 1.0);
   b.stream(s, 0.7, 0.4);
   offered += 2 * s.size();
-  report("worst case, full-scale noise, steps, impulses", b);
-  EXPECT_EQ(b.compared(), offered);
-  EXPECT_EQ(b.mismatches(), 0u);
-  EXPECT_EQ(b.protocol_errors(), 0u);
+  expect_clean("worst case, full-scale noise, steps, impulses", b, offered);
 }
 
 TEST(BandpassSosRtl, GapsAndBackPressureLoseNothing) {
@@ -536,10 +536,7 @@ TEST(BandpassSosRtl, GapsAndBackPressureLoseNothing) {
     b.stream(e, p[0], p[1]);
     offered += x.size() + e.size();
   }
-  report("random gaps and back-pressure", b);
-  EXPECT_EQ(b.compared(), offered);
-  EXPECT_EQ(b.mismatches(), 0u);
-  EXPECT_EQ(b.protocol_errors(), 0u);
+  expect_clean("random gaps and back-pressure", b, offered);
 }
 
 TEST(BandpassSosRtl, ResetMidStreamGivesAFreshFilter) {
@@ -560,10 +557,7 @@ TEST(BandpassSosRtl, ResetMidStreamGivesAFreshFilter) {
     b.stream(x, cut % 2 ? 1.0 : 0.7, cut % 3 ? 1.0 : 0.5);
     offered += x.size();
   }
-  report("reset in the middle of a stream", b);
-  EXPECT_EQ(b.compared(), offered);
-  EXPECT_EQ(b.mismatches(), 0u);
-  EXPECT_EQ(b.protocol_errors(), 0u);
+  expect_clean("reset in the middle of a stream", b, offered);
 }
 
 // The schedule the header documents: shared multipliers (two sections per SB_MAC16, one
@@ -646,14 +640,11 @@ TEST(BandpassSosRtl, OneSampleEverySixClocksNeverStalls) {
     offered += x.size();
     EXPECT_EQ(refused, 0u) << "s_ready low when a sample was offered";
   }
-  report("one sample every 6 clocks", b);
-  EXPECT_EQ(b.compared(), offered);
-  EXPECT_EQ(b.mismatches(), 0u);
-  EXPECT_EQ(b.protocol_errors(), 0u);
+  expect_clean("one sample every 6 clocks", b, offered);
 }
 
 TEST(BandpassSosRtl, VerilatorLintClean) {
-  const CmdResult r = lint(read_vc(vc_path()));
+  const CmdResult r = lint(generated_params());
   EXPECT_EQ(r.rc, 0) << r.output;
   EXPECT_EQ(r.output, "");
 }
@@ -733,7 +724,7 @@ TEST(BandpassSosRtl, IcarusBitExactAcrossModes) {
       EXPECT_TRUE(differs) << var.name << ": no exact tie exercised";
     }
 
-    const ParamList params = var.from_vc ? read_vc(vc_path()) : params_for(m, var.sample_cycles);
+    const ParamList params = var.from_vc ? generated_params() : params_for(m, var.sample_cycles);
     const CmdResult l = lint(params);
     EXPECT_EQ(l.rc, 0) << var.name << ": " << l.output;
     EXPECT_EQ(l.output, "") << var.name;

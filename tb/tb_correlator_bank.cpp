@@ -30,23 +30,15 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-parameter"
 #include "Vcorrelator_bank.h"
-#include "verilated.h"
-#include "verilated_fst_c.h"
+#include "tb/generated_params.hpp"
+#include "tb/verilator_harness.hpp"
 #pragma GCC diagnostic pop
 
 namespace {
 
 using namespace ranging;
 
-const ReceiverDesign& design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
-
-std::int64_t sext(std::uint64_t v, int width) {
-  const std::uint64_t m = std::uint64_t{1} << (width - 1);
-  return static_cast<std::int64_t>((v ^ m) - m);
-}
+const ReceiverDesign& design() { return tb::configured_design(); }
 
 struct Output {
   std::vector<std::uint64_t> q;
@@ -129,10 +121,7 @@ std::vector<Output> model_outputs(const std::vector<std::int64_t>& y) {
 std::vector<std::int64_t> filtered_burst(std::size_t code, double distance_mm, double noise,
                                          std::uint64_t seed, std::size_t* arrival) {
   const auto& d = design();
-  ExcitationParams ex;
-  ex.carrier_hz = d.config.carrier_hz;
-  ex.cycles_per_chip = d.config.cycles_per_chip;
-  ex.fs = d.config.fs;
+  const ExcitationParams ex = receiver_excitation(d.config);
   const auto exc = bpsk_excitation(d.family.codes.at(code), ex);
   ChannelParams ch;
   ch.distance_m = distance_mm / 1000.0;
@@ -150,65 +139,25 @@ std::vector<std::int64_t> filtered_burst(std::size_t code, double distance_mm, d
   return y;
 }
 
-class BankSim {
+// The Verilated bank on the shared harness (tb/verilator_harness.hpp), plus a beat reader.
+class BankSim : public tb::StreamHarness<Vcorrelator_bank> {
  public:
-  BankSim() : ctx_(std::make_unique<VerilatedContext>()), top_(std::make_unique<Vcorrelator_bank>(ctx_.get())) {
-    const char* tr = std::getenv("RANGING_TRACE");
-    if (tr && std::string(tr) == "1") {
-      ctx_->traceEverOn(true);
-      trace_ = std::make_unique<VerilatedFstC>();
-      top_->trace(trace_.get(), 99);
-      const char* dir = std::getenv("RANGING_TRACE_DIR");
-      trace_->open((std::string(dir ? dir : RANGING_TRACE_DIR) + "/tb_correlator_bank.fst").c_str());
-    }
-    top_->clk = 0;
-    top_->rst = 1;
-    top_->s_valid = 0;
-    top_->m_ready = 0;
-    top_->eval();
-  }
-  ~BankSim() {
-    if (trace_) trace_->close();
-    top_->final();
-  }
-  Vcorrelator_bank& top() { return *top_; }
-  void tick() {
-    top_->clk = 1;
-    top_->eval();
-    if (trace_) trace_->dump(time_++);
-    top_->clk = 0;
-    top_->eval();
-    if (trace_) trace_->dump(time_++);
-  }
-  void reset() {
-    top_->rst = 1;
-    top_->s_valid = 0;
-    tick();
-    tick();
-    top_->rst = 0;
-    top_->eval();
-  }
+  BankSim() : StreamHarness("tb_correlator_bank") {}
   Beat read() const {
     const auto& c = design().config.correlator;
+    const auto& t = top();
     Beat b;
-    b.q = top_->m_weighted;
-    b.code = top_->m_code;
-    b.last = top_->m_last != 0;
-    b.energy = top_->m_energy;
-    b.index = top_->m_index;
-    b.chip_re = sext(top_->m_chip_re, c.chip_bits);
-    b.chip_im = sext(top_->m_chip_im, c.chip_bits);
-    b.corr_re = sext(top_->m_corr_re, c.corr_bits);
-    b.corr_im = sext(top_->m_corr_im, c.corr_bits);
+    b.q = t.m_weighted;
+    b.code = t.m_code;
+    b.last = t.m_last != 0;
+    b.energy = t.m_energy;
+    b.index = t.m_index;
+    b.chip_re = tb::sign_extend(t.m_chip_re, c.chip_bits);
+    b.chip_im = tb::sign_extend(t.m_chip_im, c.chip_bits);
+    b.corr_re = tb::sign_extend(t.m_corr_re, c.corr_bits);
+    b.corr_im = tb::sign_extend(t.m_corr_im, c.corr_bits);
     return b;
   }
-  std::uint64_t cycles() const { return time_ / 2; }
-
- private:
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<Vcorrelator_bank> top_;
-  std::unique_ptr<VerilatedFstC> trace_;
-  std::uint64_t time_ = 0;
 };
 
 // First differing stage of one output, or "" when equal.
@@ -526,25 +475,14 @@ struct Packer {
   }
 };
 
-// CODE_W of the .vc (the module's default, 4, while the generator does not pass it).
-int vc_code_bits() {
-  std::ifstream f(kVc);
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind("-GCODE_W=", 0) == 0) return std::stoi(line.substr(9));
-  return 4;
-}
+// The bank's parameters as the generator writes them into the .vc (tb/generated_params.hpp).
+HwModuleParams bank_params() { return tb::generated_module(design(), "correlator_bank"); }
 
-// module iv_top instantiating the Icarus testbench with the generated parameters (.vc).
-std::string wrapper_from_vc(const std::string& tb_module, const std::vector<std::string>& extra) {
-  std::ifstream f(kVc);
-  std::string line, params;
+// module iv_top instantiating the Icarus testbench with the generated parameters.
+std::string iverilog_wrapper(const std::string& tb_module, const std::vector<std::string>& extra) {
+  std::string params;
   for (const auto& e : extra) params += (params.empty() ? "" : ",\n    ") + e;
-  while (std::getline(f, line)) {
-    if (line.rfind("-G", 0) != 0) continue;
-    const auto eq = line.find('=');
-    params += ",\n    ." + line.substr(2, eq - 2) + "(" + line.substr(eq + 1) + ")";
-  }
+  for (const auto& [name, value] : tb::verilog_params(bank_params())) params += ",\n    ." + name + "(" + value + ")";
   return "module iv_top;\n  " + tb_module + " #(\n    " + params + "\n  ) tb();\nendmodule\n";
 }
 
@@ -557,7 +495,7 @@ TEST(CorrelatorBankRtl, IcarusSimulationMatchesModel) {
   std::vector<std::int64_t> seg(y.begin() + static_cast<std::ptrdiff_t>(arrival - 300),
                                 y.begin() + static_cast<std::ptrdiff_t>(arrival + 1700));
   const auto exp = model_outputs(seg);
-  const int code_bits = vc_code_bits();
+  const int code_bits = static_cast<int>(bank_params().value("CODE_W"));
   std::size_t beats = 0;
   const std::string dir = std::string(RANGING_TRACE_DIR) + "/iverilog_rtlbank/correlator_bank";
   std::filesystem::create_directories(dir);
@@ -586,7 +524,7 @@ TEST(CorrelatorBankRtl, IcarusSimulationMatchesModel) {
       }
     }
     std::ofstream w(dir + "/wrapper.v");
-    w << wrapper_from_vc("correlator_bank_iverilog_tb",
+    w << iverilog_wrapper("correlator_bank_iverilog_tb",
                          {".N_IN(" + std::to_string(seg.size()) + ")", ".N_OUT(" + std::to_string(beats) + ")"});
   }
   const std::string tb = std::string(RANGING_SOURCE_DIR) + "/tb/correlator_bank_iverilog_tb.v";

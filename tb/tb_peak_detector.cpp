@@ -37,8 +37,8 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-parameter"
 #include "Vpeak_detector.h"
-#include "verilated.h"
-#include "verilated_fst_c.h"
+#include "tb/generated_params.hpp"
+#include "tb/verilator_harness.hpp"
 #pragma GCC diagnostic pop
 
 namespace {
@@ -55,15 +55,7 @@ std::string event_mismatch(std::size_t n, const char* what, const ranging::Event
 
 using namespace ranging;
 
-const ReceiverDesign& design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
-
-std::int64_t sext(std::uint64_t v, int width) {
-  const std::uint64_t m = std::uint64_t{1} << (width - 1);
-  return static_cast<std::int64_t>(((v & ((m << 1) - 1)) ^ m) - m);
-}
+const ReceiverDesign& design() { return tb::configured_design(); }
 
 // One bank output (a group): Q_j of every code, E, n. The detector receives it as CODES beats.
 struct Beat {
@@ -82,10 +74,7 @@ void drive_beat(Vpeak_detector& t, const Beat& g, std::size_t j) {
 // Filtered received bursts, one after the other (a new burst every `spacing` samples).
 std::vector<std::int64_t> burst_stream(std::uint64_t seed, double noise, std::size_t bursts) {
   const auto& d = design();
-  ExcitationParams ex;
-  ex.carrier_hz = d.config.carrier_hz;
-  ex.cycles_per_chip = d.config.cycles_per_chip;
-  ex.fs = d.config.fs;
+  const ExcitationParams ex = receiver_excitation(d.config);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> dist_mm(100, 1000), gain(0.05, 0.8);
   BandpassFixed bp(d.filter, d.config.bandpass);
@@ -128,50 +117,20 @@ void model(const std::vector<std::int64_t>& y, std::size_t split, std::vector<Be
   if (split >= beats.size()) events_before_split = events.size();
 }
 
-class DetSim {
+// The Verilated detector on the shared harness (tb/verilator_harness.hpp), plus an event reader.
+class DetSim : public tb::StreamHarness<Vpeak_detector> {
  public:
-  DetSim() : ctx_(std::make_unique<VerilatedContext>()), top_(std::make_unique<Vpeak_detector>(ctx_.get())) {
-    const char* tr = std::getenv("RANGING_TRACE");
-    if (tr && std::string(tr) == "1") {
-      ctx_->traceEverOn(true);
-      trace_ = std::make_unique<VerilatedFstC>();
-      top_->trace(trace_.get(), 99);
-      const char* dir = std::getenv("RANGING_TRACE_DIR");
-      trace_->open((std::string(dir ? dir : RANGING_TRACE_DIR) + "/tb_peak_detector.fst").c_str());
-    }
-    top_->clk = 0;
-    top_->rst = 1;
-    top_->s_valid = 0;
-    top_->m_ready = 0;
-    top_->eval();
+  DetSim() : StreamHarness("tb_peak_detector") {}
+  // The event on m_* (valid when m_valid): the arrival is 40 integer + frac_bits + sign bits.
+  EventFixed read_event() const {
+    const auto& t = top();
+    EventFixed g;
+    g.code = t.m_code;
+    g.arrival = tb::sign_extend(t.m_arrival, 40 + design().config.detector.frac_bits + 1);
+    g.score = t.m_score;
+    g.margin = t.m_margin;
+    return g;
   }
-  ~DetSim() {
-    if (trace_) trace_->close();
-    top_->final();
-  }
-  Vpeak_detector& top() { return *top_; }
-  void tick() {
-    top_->clk = 1;
-    top_->eval();
-    if (trace_) trace_->dump(time_++);
-    top_->clk = 0;
-    top_->eval();
-    if (trace_) trace_->dump(time_++);
-  }
-  void reset() {
-    top_->rst = 1;
-    top_->s_valid = 0;
-    tick();
-    tick();
-    top_->rst = 0;
-    top_->eval();
-  }
-
- private:
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<Vpeak_detector> top_;
-  std::unique_ptr<VerilatedFstC> trace_;
-  std::uint64_t time_ = 0;
 };
 
 struct Totals {
@@ -182,7 +141,6 @@ struct Totals {
 void run_stream(DetSim& sim, const std::vector<std::int64_t>& y, double gap, double stall,
                 std::mt19937_64& rng, const std::string& what, Totals& tot) {
   const auto& d = design();
-  const int fb = d.config.detector.frac_bits;
   std::vector<Beat> beats;
   std::vector<EventFixed> events;
   std::size_t before = 0;
@@ -218,11 +176,7 @@ void run_stream(DetSim& sim, const std::vector<std::int64_t>& y, double gap, dou
     t.m_ready = u(rng) >= stall ? 1 : 0;
     t.eval();
     if (t.m_valid) {
-      EventFixed g;
-      g.code = t.m_code;
-      g.arrival = sext(t.m_arrival, 40 + fb + 1);
-      g.score = t.m_score;
-      g.margin = t.m_margin;
+      const EventFixed g = sim.read_event();
       if (holding && !(g == held)) fail("event changed while m_valid && !m_ready");
       held = g;
       holding = !t.m_ready;
@@ -363,8 +317,6 @@ struct PacedResult {
 // from a group's first beat to s_ready high again after its last beat (the group's whole time).
 PacedResult run_paced(DetSim& sim, const std::vector<Beat>& beats, const std::vector<EventFixed>& expected,
                       std::uint64_t period) {
-  const auto& d = design();
-  const int fb = d.config.detector.frac_bits;
   PacedResult r;
   auto fail = [&](const std::string& m) {
     ++r.mismatches;
@@ -382,11 +334,7 @@ PacedResult run_paced(DetSim& sim, const std::vector<Beat>& beats, const std::ve
     t.m_ready = 1;
     t.eval();
     if (t.m_valid) {
-      EventFixed g;
-      g.code = t.m_code;
-      g.arrival = sext(t.m_arrival, 40 + fb + 1);
-      g.score = t.m_score;
-      g.margin = t.m_margin;
+      const EventFixed g = sim.read_event();
       if (got >= expected.size()) {
         fail("extra event");
       } else if (!(g == expected[got])) {

@@ -21,6 +21,7 @@
 #include "model/dsp/excitation.hpp"
 #include "model/hw/hw_params.hpp"
 #include "model/dsp/receiver.hpp"
+#include "tb/bits.hpp"
 
 using namespace ranging;
 namespace fs = std::filesystem;
@@ -55,10 +56,7 @@ std::uint64_t hex_bits(const std::string& hex, int lo, int w) {
   return out;
 }
 
-std::int64_t sext(std::uint64_t v, int w) {
-  const std::uint64_t m = std::uint64_t{1} << (w - 1);
-  return static_cast<std::int64_t>(v ^ m) - static_cast<std::int64_t>(m);
-}
+using tb::sign_extend;
 
 struct BankState {
   std::uint64_t energy;
@@ -84,10 +82,7 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
   const int arr_w = tw + frac_w + 1;
 
   // Vectors: code 1 sent at sample 0, received 30 mm away, through the reference transducers.
-  ExcitationParams ex;
-  ex.carrier_hz = d.config.carrier_hz;
-  ex.cycles_per_chip = d.config.cycles_per_chip;
-  ex.fs = d.config.fs;
+  const ExcitationParams ex = receiver_excitation(d.config);
   const auto drive = hbridge_drive(d.family.codes[0], ex);
   ChannelParams ch;
   ch.distance_m = 0.03;
@@ -190,7 +185,7 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
       std::string h;
       ls >> h;
       ASSERT_LT(nf, n);
-      ASSERT_EQ(sext(hex_bits(h, 0, data_w), data_w), filt[nf]) << "filter output, sample " << nf;
+      ASSERT_EQ(sign_extend(hex_bits(h, 0, data_w), data_w), filt[nf]) << "filter output, sample " << nf;
       ++nf;
     } else if (tag == "B") {
       std::string hi, he, hr, hm, hj, hl, hq;  // one beat per code
@@ -199,8 +194,8 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
       ASSERT_LT(i, n);
       const BankState& b = bank[i];
       ASSERT_EQ(hex_bits(he, 0, ew), b.energy) << "energy at index " << i;
-      ASSERT_EQ(sext(hex_bits(hr, 0, cw), cw), b.chip_re) << "chip filter (re) at index " << i;
-      ASSERT_EQ(sext(hex_bits(hm, 0, cw), cw), b.chip_im) << "chip filter (im) at index " << i;
+      ASSERT_EQ(sign_extend(hex_bits(hr, 0, cw), cw), b.chip_re) << "chip filter (re) at index " << i;
+      ASSERT_EQ(sign_extend(hex_bits(hm, 0, cw), cw), b.chip_im) << "chip filter (im) at index " << i;
       const int j = static_cast<int>(hex_bits(hj, 0, code_w));
       ASSERT_EQ(j, beat) << "beat order at index " << i;
       ASSERT_EQ(hex_bits(hl, 0, 1) == 1, j == codes - 1) << "last flag at index " << i;
@@ -215,7 +210,7 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
       ASSERT_LT(ne, events.size()) << "extra event";
       const EventFixed& e = events[ne];
       EXPECT_EQ(static_cast<int>(hex_bits(h, 0, code_w)), e.code);
-      EXPECT_EQ(sext(hex_bits(h, code_w, arr_w), arr_w), e.arrival);
+      EXPECT_EQ(sign_extend(hex_bits(h, code_w, arr_w), arr_w), e.arrival);
       EXPECT_EQ(hex_bits(h, code_w + arr_w, sw), e.score);
       EXPECT_EQ(hex_bits(h, code_w + arr_w + sw, sw), e.margin);
       ++ne;

@@ -1,11 +1,9 @@
 // receiver_top (generated from configs/default.yaml) against ReceiverFixed, bit for bit, stage
 // by stage: every filter output and section output, every decimated correlator output (chip
 // filter, combiner, weighted powers, energy, index) and every event. A mismatch names the first
-// stage and sample where it appears. RANGING_TRACE=1 writes build/tb_receiver_top_<test>.fst
+// stage and sample where it appears. RANGING_TRACE=1 writes $RANGING_TRACE_DIR/tb_receiver_top_<test>.fst
 // (open with: gtkwave build/tb_receiver_top_<test>.fst build/generated/default/receiver.gtkw).
 #include <gtest/gtest.h>
-#include <verilated.h>
-#include <verilated_fst_c.h>
 
 #include <cstdlib>
 #include <deque>
@@ -19,37 +17,14 @@
 #include "model/sim/channel.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/receiver.hpp"
+#include "tb/generated_params.hpp"
+#include "tb/verilator_harness.hpp"
 
 using namespace ranging;
 
 namespace {
 
-// Bits [lo, lo + w) of a Verilator port (plain integer or VlWide), zero-extended.
-template <class T>
-std::uint64_t get_bits(const T& v, int lo, int w) {
-  if constexpr (std::is_integral_v<T>) {
-    const std::uint64_t u = static_cast<std::uint64_t>(v) >> lo;
-    return w >= 64 ? u : (u & ((std::uint64_t{1} << w) - 1));
-  } else {
-    std::uint64_t out = 0;
-    for (int b = 0; b < w; ++b) {
-      const int i = lo + b;
-      if ((v.at(static_cast<std::size_t>(i / 32)) >> (i % 32)) & 1u) out |= std::uint64_t{1} << b;
-    }
-    return out;
-  }
-}
-
-std::int64_t sign_extend(std::uint64_t v, int w) {
-  if (w >= 64) return static_cast<std::int64_t>(v);
-  const std::uint64_t m = std::uint64_t{1} << (w - 1);
-  return static_cast<std::int64_t>((v ^ m) - m);
-}
-
-const ReceiverDesign& design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
+const ReceiverDesign& design() { return tb::configured_design(); }
 
 std::uint64_t g_compared_samples = 0;
 
@@ -71,29 +46,15 @@ const bool g_registered = [] {
 class Bench {
  public:
   Bench(const std::string& name, double valid_prob, double ready_prob, std::uint64_t seed)
-      : model_(design()), rng_(seed), valid_prob_(valid_prob), ready_prob_(ready_prob) {
-    ctx_ = std::make_unique<VerilatedContext>();
-    dut_ = std::make_unique<Vreceiver_top>(ctx_.get());
-    const char* trace = std::getenv("RANGING_TRACE");
-    if (trace && std::string(trace) == "1") {
-      ctx_->traceEverOn(true);
-      fst_ = std::make_unique<VerilatedFstC>();
-      dut_->trace(fst_.get(), 99);
-      fst_->open((std::string(RANGING_TRACE_DIR) + "/tb_receiver_top_" + name + ".fst").c_str());
-    }
+      : model_(design()), h_("tb_receiver_top_" + name), dut_(&h_.top()), rng_(seed), valid_prob_(valid_prob),
+        ready_prob_(ready_prob) {
     reset();
-  }
-  ~Bench() {
-    if (fst_) fst_->close();
-    dut_->final();
   }
 
   void reset() {
-    dut_->rst = 1;
     dut_->s_axis_tvalid = 0;
     dut_->m_axis_tready = 0;
-    for (int i = 0; i < 4; ++i) tick();
-    dut_->rst = 0;
+    h_.reset(4);
     model_.reset();
     pending_.clear();
     filter_expect_.clear();
@@ -116,8 +77,7 @@ class Bench {
       dut_->s_axis_tvalid = offer;
       if (offer) dut_->s_axis_tdata = static_cast<std::uint16_t>(x[next]) & 0xfff;
       dut_->m_axis_tready = coin(ready_prob_);
-      dut_->clk = 0;
-      dut_->eval();
+      h_.settle();
       // Beats completing at this rising edge.
       if (offer && dut_->s_axis_tready) {
         feed_model(x[next]);
@@ -125,7 +85,7 @@ class Bench {
         idle = 0;
       }
       if (auto r = check_taps(); !r) return r;
-      tick_high();
+      h_.tick();
       if (++idle > 200000) return ::testing::AssertionFailure() << "DUT stalled";
     }
     return ::testing::AssertionSuccess();
@@ -167,13 +127,13 @@ class Bench {
       if (filter_expect_.empty()) return ::testing::AssertionFailure() << "filter: unexpected output";
       const auto& [y, sections] = filter_expect_.front();
       for (std::size_t k = 0; k < sections.size(); ++k) {
-        const auto got = sign_extend(get_bits(dut_->dbg_filter_sections, static_cast<int>(k) * dw, dw), dw);
+        const auto got = tb::sign_extend(tb::port_bits(dut_->dbg_filter_sections, static_cast<int>(k) * dw, dw), dw);
         if (got != sections[k]) {
           return ::testing::AssertionFailure() << "first mismatch: filter section " << k + 1 << " at filter sample "
                                                << filt_count_ << ": rtl " << got << " model " << sections[k];
         }
       }
-      const auto got = sign_extend(get_bits(dut_->dbg_filter_data, 0, dw), dw);
+      const auto got = tb::sign_extend(tb::port_bits(dut_->dbg_filter_data, 0, dw), dw);
       if (got != y) return ::testing::AssertionFailure() << "filter output at sample " << filt_count_;
       filter_expect_.pop_front();
       ++filt_count_;
@@ -192,21 +152,21 @@ class Bench {
         return ::testing::AssertionFailure() << "first mismatch: beat framing: code " << int(dut_->dbg_code)
                                              << " last " << int(dut_->dbg_last) << where.str();
       }
-      if (sign_extend(get_bits(dut_->dbg_chip_re, 0, cw), cw) != e.chip_re ||
-          sign_extend(get_bits(dut_->dbg_chip_im, 0, cw), cw) != e.chip_im) {
+      if (tb::sign_extend(tb::port_bits(dut_->dbg_chip_re, 0, cw), cw) != e.chip_re ||
+          tb::sign_extend(tb::port_bits(dut_->dbg_chip_im, 0, cw), cw) != e.chip_im) {
         return ::testing::AssertionFailure() << "first mismatch: chip filter F" << where.str();
       }
-      if (sign_extend(get_bits(dut_->dbg_corr_re, 0, kw), kw) != e.corr_re[j] ||
-          sign_extend(get_bits(dut_->dbg_corr_im, 0, kw), kw) != e.corr_im[j]) {
+      if (tb::sign_extend(tb::port_bits(dut_->dbg_corr_re, 0, kw), kw) != e.corr_re[j] ||
+          tb::sign_extend(tb::port_bits(dut_->dbg_corr_im, 0, kw), kw) != e.corr_im[j]) {
         return ::testing::AssertionFailure() << "first mismatch: combiner C code " << j + 1 << where.str();
       }
-      if (get_bits(dut_->dbg_weighted, 0, qw) != e.q[j]) {
+      if (tb::port_bits(dut_->dbg_weighted, 0, qw) != e.q[j]) {
         return ::testing::AssertionFailure() << "first mismatch: weighted power Q code " << j + 1 << where.str();
       }
-      if (get_bits(dut_->dbg_energy, 0, l.energy_bits) != e.energy) {
+      if (tb::port_bits(dut_->dbg_energy, 0, l.energy_bits) != e.energy) {
         return ::testing::AssertionFailure() << "first mismatch: energy" << where.str();
       }
-      if (static_cast<std::int64_t>(get_bits(dut_->dbg_index, 0, 40)) != e.index) {
+      if (static_cast<std::int64_t>(tb::port_bits(dut_->dbg_index, 0, 40)) != e.index) {
         return ::testing::AssertionFailure() << "first mismatch: sample index" << where.str();
       }
       if (++bank_beat_ == l.codes) {
@@ -220,10 +180,10 @@ class Bench {
       const EventFixed& e = event_expect_.front();
       const int code_w = 4, arrival_w = 40 + design().config.detector.frac_bits + 1;
       const int score_w = design().config.correlator.score_bits;
-      const int code = static_cast<int>(get_bits(dut_->m_axis_tdata, 0, code_w));
-      const auto arrival = sign_extend(get_bits(dut_->m_axis_tdata, code_w, arrival_w), arrival_w);
-      const auto score = get_bits(dut_->m_axis_tdata, code_w + arrival_w, score_w);
-      const auto margin = get_bits(dut_->m_axis_tdata, code_w + arrival_w + score_w, score_w);
+      const int code = static_cast<int>(tb::port_bits(dut_->m_axis_tdata, 0, code_w));
+      const auto arrival = tb::sign_extend(tb::port_bits(dut_->m_axis_tdata, code_w, arrival_w), arrival_w);
+      const auto score = tb::port_bits(dut_->m_axis_tdata, code_w + arrival_w, score_w);
+      const auto margin = tb::port_bits(dut_->m_axis_tdata, code_w + arrival_w + score_w, score_w);
       if (code != e.code || arrival != e.arrival || score != e.score || margin != e.margin) {
         return ::testing::AssertionFailure()
                << "first mismatch: event " << events_seen_ << ": rtl {" << code << ", " << arrival << ", "
@@ -236,26 +196,9 @@ class Bench {
     return ::testing::AssertionSuccess();
   }
 
-  void tick_high() {
-    dut_->clk = 1;
-    dut_->eval();
-    if (fst_) fst_->dump(ctx_->time());
-    ctx_->timeInc(1);
-    dut_->clk = 0;
-    dut_->eval();
-    if (fst_) fst_->dump(ctx_->time());
-    ctx_->timeInc(1);
-  }
-  void tick() {
-    dut_->clk = 0;
-    dut_->eval();
-    tick_high();
-  }
-
   ReceiverFixed model_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<Vreceiver_top> dut_;
-  std::unique_ptr<VerilatedFstC> fst_;
+  tb::Harness<Vreceiver_top> h_;
+  Vreceiver_top* dut_;  // h_.top()
   std::mt19937_64 rng_;
   double valid_prob_, ready_prob_;
   std::deque<std::pair<std::int64_t, std::vector<std::int64_t>>> filter_expect_;

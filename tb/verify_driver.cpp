@@ -20,12 +20,8 @@
 //   S <samples taken>                                          stalled: s_axis_tready stuck low
 //   end <samples taken> <cycles>
 // Hex values are the whole port, most significant word first (VlWide: 32-bit words).
-// RANGING_TRACE=1 writes RANGING_TRACE_DIR/verify_<NAME>.fst (compiled with --trace-fst).
-#include <verilated.h>
-#if VM_TRACE
-#include <verilated_fst_c.h>
-#endif
-
+// RANGING_TRACE=1 writes $RANGING_TRACE_DIR/verify_<NAME>.fst (when compiled with --trace-fst;
+// tb/verilator_harness.hpp, "." when RANGING_TRACE_DIR is unset).
 #include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
@@ -35,6 +31,7 @@
 #include <type_traits>
 
 #include "Vreceiver_top.h"
+#include "verilator_harness.hpp"  // next to this file: the shared harness
 
 namespace {
 
@@ -49,67 +46,12 @@ void hex(std::FILE* f, const VlWide<N>& v) {
   for (std::size_t i = N; i-- > 0;) std::fprintf(f, "%08" PRIx32, static_cast<std::uint32_t>(v.at(i)));
 }
 
-class Dut {
- public:
-  explicit Dut(const std::string& name) : ctx_(std::make_unique<VerilatedContext>()) {
-#if VM_TRACE
-    const char* t = std::getenv("RANGING_TRACE");
-    const bool trace = t != nullptr && std::string(t) == "1";
-    if (trace) ctx_->traceEverOn(true);
-#endif
-    top_ = std::make_unique<Vreceiver_top>(ctx_.get());
-#if VM_TRACE
-    if (trace) {
-      const char* d = std::getenv("RANGING_TRACE_DIR");
-      fst_ = std::make_unique<VerilatedFstC>();
-      top_->trace(fst_.get(), 99);
-      fst_->open(((d && *d ? std::string(d) : std::string(".")) + "/verify_" + name + ".fst").c_str());
-    }
-#else
-    (void)name;
-#endif
-  }
-  ~Dut() {
-    top_->final();
-#if VM_TRACE
-    if (fst_) fst_->close();
-#endif
-  }
-  Vreceiver_top& t() { return *top_; }
-  void eval() { top_->eval(); }
-  void edge() {  // rising then falling edge
-    top_->clk = 1;
-    top_->eval();
-    dump();
-    top_->clk = 0;
-    top_->eval();
-    dump();
-  }
-
- private:
-  void dump() {
-#if VM_TRACE
-    if (fst_) fst_->dump(ctx_->time());
-#endif
-    ctx_->timeInc(1);
-  }
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<Vreceiver_top> top_;
-#if VM_TRACE
-  std::unique_ptr<VerilatedFstC> fst_;
-#endif
-};
+using Dut = ranging::tb::Harness<Vreceiver_top>;
 
 void reset(Dut& d) {
-  d.t().rst = 1;
-  d.t().s_axis_tvalid = 0;
-  d.t().m_axis_tready = 0;
-  for (int i = 0; i < 4; ++i) {
-    d.t().clk = 0;
-    d.eval();
-    d.edge();
-  }
-  d.t().rst = 0;
+  d.top().s_axis_tvalid = 0;
+  d.top().m_axis_tready = 0;
+  d.reset(4);
 }
 
 }  // namespace
@@ -141,7 +83,7 @@ int main(int argc, char** argv) {
     std::fprintf(out, "run %s\n", name);
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    Dut d(name);
+    Dut d(std::string("verify_") + name);
     reset(d);
     std::size_t next = 0;
     std::uint64_t cycles = 0, idle = 0, silent = 0;
@@ -153,17 +95,16 @@ int main(int argc, char** argv) {
         reset_at = -1;
       }
       const bool offer = next < x.size() && u(rng) < valid_prob;
-      d.t().s_axis_tvalid = offer;
-      if (offer) d.t().s_axis_tdata = static_cast<std::remove_reference_t<decltype(d.t().s_axis_tdata)>>(x[next]);
-      d.t().m_axis_tready = u(rng) < ready_prob;
-      d.t().clk = 0;
-      d.eval();
+      d.top().s_axis_tvalid = offer;
+      if (offer) d.top().s_axis_tdata = static_cast<std::remove_reference_t<decltype(d.top().s_axis_tdata)>>(x[next]);
+      d.top().m_axis_tready = u(rng) < ready_prob;
+      d.settle();
       bool beat = false;
-      if (offer && d.t().s_axis_tready) {
+      if (offer && d.top().s_axis_tready) {
         ++next;
         idle = 0;
       }
-      auto& t = d.t();
+      auto& t = d.top();
       if (t.dbg_filter_valid) {
         std::fputc('F', out);
         hex(out, t.dbg_filter_data);
@@ -191,7 +132,7 @@ int main(int argc, char** argv) {
         std::fputc('\n', out);
         beat = true;
       }
-      d.edge();
+      d.tick();
       ++cycles;
       silent = (beat || next < x.size()) ? 0 : silent + 1;
       if (next < x.size() && ++idle > 200000) {

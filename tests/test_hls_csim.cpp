@@ -192,10 +192,7 @@ std::vector<std::int64_t> to_adc(const std::vector<double>& v) {
 std::vector<std::int64_t> coded_signal(int code, double distance_m, double noise_rms, std::uint64_t seed,
                                        double gain = 0.5) {
   const ReceiverDesign& d = default_design();
-  ExcitationParams ex;
-  ex.carrier_hz = d.config.carrier_hz;
-  ex.cycles_per_chip = d.config.cycles_per_chip;
-  ex.fs = d.config.fs;
+  const ExcitationParams ex = receiver_excitation(d.config);
   const auto exc = bpsk_excitation(d.family.codes[static_cast<std::size_t>(code)], ex);
   ChannelParams c;
   c.distance_m = distance_m;

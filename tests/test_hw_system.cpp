@@ -49,10 +49,7 @@ TEST(HwSystem, DriveIsTheScheduleOfHbridgeBursts) {
   const auto& s = sys();
   const std::size_t n = static_cast<std::size_t>(s.period_t) * (s.codes + 1);
   const auto drive = system_drive(d, s, n);
-  ExcitationParams ex;
-  ex.carrier_hz = d.config.carrier_hz;
-  ex.cycles_per_chip = d.config.cycles_per_chip;
-  ex.fs = d.config.fs;
+  const ExcitationParams ex = receiver_excitation(d.config);
   for (int b = 0; b <= s.codes; ++b) {
     const auto h = hbridge_drive(d.family.codes[static_cast<std::size_t>(b % s.codes)], ex);
     const std::size_t start = static_cast<std::size_t>(b) * s.period_t;

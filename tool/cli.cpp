@@ -133,19 +133,34 @@ std::string Parser::get_or(const std::string& name, const std::string& fallback)
   return get(name).value_or(fallback);
 }
 
-double Parser::number(const std::string& name, double fallback, double lo, double hi) const {
-  auto v = get(name);
-  double x = fallback;
-  if (v) {
-    const char* b = v->data();
-    const char* e = v->data() + v->size();
-    auto [ptr, ec] = std::from_chars(b, e, x);
-    if (ec != std::errc() || ptr != e) {
-      std::ostringstream os;
-      os << "option " << name << ": '" << *v << "' is not a number; valid range is [" << lo << ", " << hi << "]";
-      throw InputError(os.str());
-    }
+std::string Parser::required(const std::string& name) const {
+  const auto v = get(name);
+  if (!v) throw InputError("option " + name + " is required");
+  return *v;
+}
+
+namespace {
+
+// The whole of `text` as a T (from_chars), or InputError "option NAME: 'text' is not a KIND".
+template <class T, class Range>
+T parse_whole(const std::string& name, const std::string& text, const char* kind, Range lo, Range hi) {
+  T x{};
+  const char* b = text.data();
+  const char* e = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(b, e, x);
+  if (ec != std::errc() || ptr != e) {
+    std::ostringstream os;
+    os << "option " << name << ": '" << text << "' is not " << kind << "; valid range is [" << lo << ", " << hi << "]";
+    throw InputError(os.str());
   }
+  return x;
+}
+
+}  // namespace
+
+double Parser::number(const std::string& name, double fallback, double lo, double hi) const {
+  const auto v = get(name);
+  const double x = v ? parse_whole<double>(name, *v, "a number", lo, hi) : fallback;
   std::ostringstream range;
   range << "option " << name;
   ranging::require_in_range(range.str(), x, lo, hi);
@@ -154,18 +169,8 @@ double Parser::number(const std::string& name, double fallback, double lo, doubl
 
 long long Parser::integer(const std::string& name, long long fallback, long long lo,
                           long long hi) const {
-  auto v = get(name);
-  long long x = fallback;
-  if (v) {
-    const char* b = v->data();
-    const char* e = v->data() + v->size();
-    auto [ptr, ec] = std::from_chars(b, e, x);
-    if (ec != std::errc() || ptr != e) {
-      std::ostringstream os;
-      os << "option " << name << ": '" << *v << "' is not an integer; valid range is [" << lo << ", " << hi << "]";
-      throw InputError(os.str());
-    }
-  }
+  const auto v = get(name);
+  const long long x = v ? parse_whole<long long>(name, *v, "an integer", lo, hi) : fallback;
   if (x < lo || x > hi) {
     std::ostringstream os;
     os << "option " << name << ": " << x << " is out of range; valid range is [" << lo << ", "

@@ -31,6 +31,8 @@ class Parser {
   bool has(const std::string& name) const;  // flag given, or option given (not default)
   std::optional<std::string> get(const std::string& name) const;  // value or default
   std::string get_or(const std::string& name, const std::string& fallback) const;
+  // The value of an option the command cannot run without: InputError "option NAME is required".
+  std::string required(const std::string& name) const;
   // Every value of a repeatable option, in order (e.g. --set KEY=VALUE --set ...).
   std::vector<std::string> values(const std::string& name) const;
   // Numeric options: validated to be finite and within [lo, hi]; the error names the option.

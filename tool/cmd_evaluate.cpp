@@ -24,6 +24,7 @@
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/options.hpp"
 #include "tool/scene_run.hpp"
 
 namespace ranging::tool {
@@ -162,35 +163,8 @@ std::string explanations(const Scene& scene, const std::vector<FamilySummary>& s
   return md.str();
 }
 
-}  // namespace
-
-int cmd_evaluate(const Args& args) {
-  cli::Parser p("ranging evaluate",
-                "Reproduce the paper's Section 4 from a scene: Table 4 (u_min, Energy_min), Table 5\n"
-                "(T_d-max), Table 6 (v_max), Figures 13-15 (PNG via scripts/plot_section4.py) and a\n"
-                "generated Markdown document comparing the paper's values with ours.");
-  p.positional("SCENE", "scene file, e.g. scenes/paper-section4.yaml");
-  p.option("--out", "DIR", "output directory (default: out/<scene name>; the committed results: --out docs/results)");
-  p.flag("--no-plots", "skip the PNG figures (no Python needed)");
-  p.flag("--json", "print the tables as JSON on stdout");
-  p.option("--set", "KEY=VALUE", "override a key of the scene, a dotted YAML path (repeatable): noise.noise_v=0.01; receiver.config.KEY sets a key of its receiver configuration, e.g. receiver.config.correlator_fixed.chip_bits=18");
-  p.flag("--quiet", "no progress bar");
-  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
-  if (!p.parse(args)) return 0;
-  const std::string scene_path = p.positionals().at(0);
-  const Overrides overrides = parse_overrides(p.values("--set"));
-  Scene scene = load_scene(scene_path, overrides, p.has("--allow-out-of-spec"));
-  warn_if_out_of_spec("evaluate", scene.receiver.config);
-  const std::string out = p.get_or("--out", "out/" + scene.name);
-  namespace fs = std::filesystem;
-  OutputDir out_dir(out, "option --out");  // removed again if the run fails
-
-  SceneSimulator sim(scene);
-  if (!p.has("--json") && !p.has("--quiet")) std::cerr << stages_text(sim);
-  const SceneRun run = run_scene(sim, p.has("--quiet") || p.has("--json"));
-  const std::string stem = out + "/" + scene.name;
-
-  // Data for the figures: per code (Fig. 14, 15 and T_d) and Figure 13's waveforms.
+// Figures 14, 15 and T_d data: one row per family and code.
+void write_per_code_csv(const SceneRun& run, const std::string& stem) {
   std::ostringstream per;
   per << "family,code,u_mean,energy_at_max_distance_v2,td_max_s,detector_rho2_margin_mean\n";
   for (const auto& s : run.summaries) {
@@ -200,36 +174,36 @@ int cmd_evaluate(const Args& args) {
     }
   }
   write_file_atomic(stem + "-per-code.csv", per.str());
-  const std::string fig13_family = scene.excitation.families.front();
-  const double dmin = *std::min_element(scene.geometry.distances_m.begin(), scene.geometry.distances_m.end());
-  {
-    std::ostringstream w;
-    const int eta = code_family(fig13_family).eta();
-    std::vector<std::vector<double>> waves;
-    std::size_t n = 0;
-    for (int j = 1; j <= eta; ++j) {
-      waves.push_back(sim.filtered_burst(fig13_family, j, dmin));
-      n = std::max(n, waves.back().size());
-    }
-    w << "time_s";
-    for (int j = 1; j <= eta; ++j) w << "," << fig13_family << "-" << j;
-    w << "\n";
-    for (std::size_t i = 0; i < n; ++i) {
-      w << static_cast<double>(i) / scene.fs;
-      for (const auto& v : waves) w << "," << (i < v.size() ? v[i] : 0.0);
-      w << "\n";
-    }
-    write_file_atomic(stem + "-fig13.csv", w.str());
-  }
-  write_file_atomic(stem + "-summary.json", summary_json(sim, run).dump(2) + "\n");
-  // With overrides, the effective scene (and configuration) beside the results: DIR/NAME-scene.yaml.
-  if (!overrides.empty()) write_effective_scene(scene, out, scene.name + "-");
+}
 
-  // Eqs. 7-8 (Figure 11, bandpass curve): rho_j(d) = Pearson of code j's filtered noise-free
-  // received burst at d with the one at d_min (the same code), the d_min burst's L + 3 chips
-  // from its arrival as the reference, searched over +-1 chip around d's arrival, the peak
-  // interpolated between samples (the fractional sample of each arrival must not count as a
-  // shape change); rho(d) = the mean over the group's codes.
+// Figure 13's data: the filtered noise-free received bursts of every code of `family` at dmin.
+void write_fig13_csv(SceneSimulator& sim, const std::string& fig13_family, double dmin, const std::string& stem) {
+  const Scene& scene = sim.scene();
+  std::ostringstream w;
+  const int eta = code_family(fig13_family).eta();
+  std::vector<std::vector<double>> waves;
+  std::size_t n = 0;
+  for (int j = 1; j <= eta; ++j) {
+    waves.push_back(sim.filtered_burst(fig13_family, j, dmin));
+    n = std::max(n, waves.back().size());
+  }
+  w << "time_s";
+  for (int j = 1; j <= eta; ++j) w << "," << fig13_family << "-" << j;
+  w << "\n";
+  for (std::size_t i = 0; i < n; ++i) {
+    w << static_cast<double>(i) / scene.fs;
+    for (const auto& v : waves) w << "," << (i < v.size() ? v[i] : 0.0);
+    w << "\n";
+  }
+  write_file_atomic(stem + "-fig13.csv", w.str());
+}
+
+// Eqs. 7-8 (Figure 11, bandpass curve): rho_j(d) = Pearson of code j's filtered noise-free
+// received burst at d with the one at d_min (the same code), the d_min burst's L + 3 chips
+// from its arrival as the reference, searched over +-1 chip around d's arrival, the peak
+// interpolated between samples (the fractional sample of each arrival must not count as a
+// shape change); rho(d) = the mean over the group's codes.
+nlohmann::json write_rho_d_csv(SceneSimulator& sim, const Scene& scene, const std::string& stem) {
   std::ostringstream rd;
   rd << "family,distance_m,rho_d\n";
   nlohmann::json rho_d = nlohmann::json::object();
@@ -272,22 +246,29 @@ int cmd_evaluate(const Args& args) {
     rho_d[fam] = per;
   }
   write_file_atomic(stem + "-rho-d.csv", rd.str());
+  return rho_d;
+}
 
+// The PNG figures (scripts/plot_section4.py), their file names in the order 13, 14, 15, 11.
+std::vector<std::string> draw_figures(const Scene& scene, const std::string& stem, const std::string& fig13_family) {
+  namespace fs = std::filesystem;
   std::vector<std::string> figures;
-  if (!p.has("--no-plots")) {
-    // The script ships with the sources: next to this file's tree, else under the working directory.
-    std::string script = (fs::path(__FILE__).parent_path().parent_path() / "scripts/plot_section4.py").string();
-    if (!fs::exists(script)) script = "scripts/plot_section4.py";
-    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + stem + "' '" + fig13_family + "' > /dev/null";
-    if (std::system(cmd.c_str()) != 0) {
-      throw InputError("figures: '" + cmd + "' failed (matplotlib missing? use --no-plots)");
-    }
-    for (const char* k : {"fig13", "fig14", "fig15", "fig11"}) figures.push_back(scene.name + "-" + k + ".png");
+  // The script ships with the sources (the tree this tool was built from), else under the working
+  // directory. (__FILE__ is relative to the build folder under ccache's base_dir, so not used.)
+  std::string script = std::string(build_info::kSourceDir) + "/scripts/plot_section4.py";
+  if (!fs::exists(script)) script = "scripts/plot_section4.py";
+  const std::string cmd = "/usr/bin/python3 '" + script + "' '" + stem + "' '" + fig13_family + "' > /dev/null";
+  if (std::system(cmd.c_str()) != 0) {
+    throw InputError("figures: '" + cmd + "' failed (matplotlib missing? use --no-plots)");
   }
+  for (const char* k : {"fig13", "fig14", "fig15", "fig11"}) figures.push_back(scene.name + "-" + k + ".png");
+  return figures;
+}
 
-  // The comparison document, generated.
+// The document's title, scene, stages and definitions.
+std::string introduction(const std::string& scene_path, const Scene& scene, const SceneSimulator& sim,
+                         const SceneRun& run, double dmin) {
   std::ostringstream md;
-  const auto& paper = paper_values();
   md << "# The paper's Section 4, reproduced\n\n"
      << "Generated by `ranging evaluate " << scene_path << "` -- do not edit by hand.\n\n"
      << "Scene `" << scene_path << "`: families";
@@ -311,7 +292,19 @@ int cmd_evaluate(const Args& args) {
      << f(scene.speed(), 1) << " m/s, L = " << f(scene.range_l(), 2)
      << " m (eq. 4, Table 6). Decode errors count the receiver's misses and misdecodes and the Pearson "
         "decoder's misdecodes; the two decoders are also listed apart.\n\n";
+  return md.str();
+}
 
+// The side-by-side table of the paper's values and ours, and what the checks and the JSON need.
+struct Comparison {
+  nlohmann::json tables = nlohmann::json::array(), rank = nlohmann::json::object();
+  bool vmax_ok = true, td_ok = true, have_m = false, have_m15 = false, have_gold = false;
+  double m_energy = 1e300, m15_energy = 1e300, gold_energy = 0;
+};
+
+Comparison compare_with_paper(const SceneRun& run, std::ostringstream& md) {
+  Comparison c;
+  const auto& paper = paper_values();
   // Per family: ours and the paper's; groups of rows for the side-by-side table.
   struct Item {
     std::string family;
@@ -452,6 +445,22 @@ int cmd_evaluate(const Args& args) {
      << "| energy max/min within a family | Gold1-7 | 3.02-4.38 | " << range(e_ratio_gold)
      << " | | | predicted |\n";
 
+  c.tables = tables;
+  c.rank = rank;
+  c.vmax_ok = vmax_ok;
+  c.td_ok = td_ok;
+  c.have_m = have_m;
+  c.have_m15 = have_m15;
+  c.have_gold = have_gold;
+  c.m_energy = m_energy;
+  c.m15_energy = m15_energy;
+  c.gold_energy = gold_energy;
+  return c;
+}
+
+// "Both decoders": per family, the detector's and the Pearson decoder's errors; returns the
+// number of T_d measurements the search range clipped.
+std::size_t decoders_table(const SceneRun& run, std::ostringstream& md) {
   md << "\n## Both decoders\n\n"
      << "The hardware detector (receiver rho^2 score, docs/architecture.md) and the paper's Pearson matched "
         "filter, each with its own errors; `errors` is their union (a burst either decoder got wrong or "
@@ -466,35 +475,87 @@ int cmd_evaluate(const Args& args) {
        << " | " << f(s.detector_margin_min, 3) << " | " << s.pearson_errors << " | " << f(s.u_min, 3) << " | "
        << s.td_clipped << " | " << s.td_noise_limited << " |\n";
   }
-  const bool energy_ok = have_m && have_gold && m_energy > gold_energy;
-  const bool energy15_ok = have_m15 && have_gold && m15_energy > gold_energy;
+  return td_clipped_total;
+}
+
+std::string figures_section(const std::vector<std::string>& figures, const std::string& fig13_family, double dmin,
+                            const Scene& scene) {
+  std::ostringstream md;
+  md << "\n## Figures\n\n";
+  md << "![Figure 13](" << figures[0] << ")\n\nFigure 13: filtered noise-free received bursts of every "
+     << fig13_family << " code at " << f(dmin * 1e3, 0) << " mm.\n\n";
+  md << "![Figure 14](" << figures[1] << ")\n\nFigure 14: u (eq. 10) per code (mean over distances and repeats).\n\n";
+  md << "![Figure 15](" << figures[2] << ")\n\nFigure 15: energy per code at "
+     << f(scene.range_l() * 1e3, 0) << " mm (mean over repeats).\n\n";
+  md << "![Figure 11](" << figures[3] << ")\n\nFigure 11 (bandpass curve, eqs. 7-8): rho(d), the correlation of "
+        "each code's filtered received burst at d with the one at "
+     << f(dmin * 1e3, 0)
+     << " mm, averaged over the group (noise-free bursts: the change of shape with distance, which here "
+        "comes from the air absorption alone; the paper's measured curve also carries noise).\n";
+  return md.str();
+}
+
+}  // namespace
+
+int cmd_evaluate(const Args& args) {
+  cli::Parser p("ranging evaluate",
+                "Reproduce the paper's Section 4 from a scene: Table 4 (u_min, Energy_min), Table 5\n"
+                "(T_d-max), Table 6 (v_max), Figures 13-15 (PNG via scripts/plot_section4.py) and a\n"
+                "generated Markdown document comparing the paper's values with ours.");
+  p.positional("SCENE", "scene file, e.g. scenes/paper-section4.yaml");
+  p.option("--out", "DIR", "output directory (default: out/<scene name>; the committed results: --out docs/results)");
+  p.flag("--no-plots", "skip the PNG figures (no Python needed)");
+  p.flag("--json", "print the tables as JSON on stdout");
+  add_scene_options(p);
+  if (!p.parse(args)) return 0;
+  const std::string scene_path = p.positionals().at(0);
+  Overrides overrides;
+  const Scene scene = load_scene_options(p, "evaluate", &overrides);
+  const std::string out = p.get_or("--out", "out/" + scene.name);
+  OutputDir out_dir(out, "option --out");  // removed again if the run fails
+
+  SceneSimulator sim(scene);
+  if (!p.has("--json") && !p.has("--quiet")) std::cerr << stages_text(sim);
+  const SceneRun run = run_scene(sim, p.has("--quiet") || p.has("--json"));
+  const std::string stem = out + "/" + scene.name;
+
+  write_per_code_csv(run, stem);
+  const std::string fig13_family = scene.excitation.families.front();
+  const double dmin = *std::min_element(scene.geometry.distances_m.begin(), scene.geometry.distances_m.end());
+  write_fig13_csv(sim, fig13_family, dmin, stem);
+  write_file_atomic(stem + "-summary.json", summary_json(sim, run).dump(2) + "\n");
+  // With overrides, the effective scene (and configuration) beside the results: DIR/NAME-scene.yaml.
+  if (!overrides.empty()) write_effective_scene(scene, out, scene.name + "-");
+
+  const nlohmann::json rho_d = write_rho_d_csv(sim, scene, stem);
+
+  const std::vector<std::string> figures =
+      p.has("--no-plots") ? std::vector<std::string>{} : draw_figures(scene, stem, fig13_family);
+
+  // The comparison document, generated.
+  std::ostringstream md;
+  md << introduction(scene_path, scene, sim, run, dmin);
+
+  const Comparison cmp = compare_with_paper(run, md);
+
+  const std::size_t td_clipped_total = decoders_table(run, md);
+  const bool energy_ok = cmp.have_m && cmp.have_gold && cmp.m_energy > cmp.gold_energy;
+  const bool energy15_ok = cmp.have_m15 && cmp.have_gold && cmp.m15_energy > cmp.gold_energy;
   md << "\n## Checks\n\n"
-     << "- v_max equal to Table 6 (2380 Hz for M1/M2, 3060 Hz for Gold): **" << (vmax_ok ? "yes" : "NO") << "**\n"
-     << "- T_d-max within 10 % of Table 5: **" << (td_ok ? "yes" : "NO") << "**\n"
+     << "- v_max equal to Table 6 (2380 Hz for M1/M2, 3060 Hz for Gold): **" << (cmp.vmax_ok ? "yes" : "NO") << "**\n"
+     << "- T_d-max within 10 % of Table 5: **" << (cmp.td_ok ? "yes" : "NO") << "**\n"
      << "- T_d measurements clipped by the search range: **" << td_clipped_total << "**\n";
-  if (have_m && have_gold) {
+  if (cmp.have_m && cmp.have_gold) {
     md << "- 7-bit M (M1/M2) Energy_min above every Gold family's, as in Table 4: **" << (energy_ok ? "yes" : "NO")
-       << "** (M1/M2 smallest " << f(m_energy, 3) << " V^2, Gold largest " << f(gold_energy, 3) << " V^2)\n";
+       << "** (M1/M2 smallest " << f(cmp.m_energy, 3) << " V^2, Gold largest " << f(cmp.gold_energy, 3) << " V^2)\n";
   }
-  if (have_m15 && have_gold) {
+  if (cmp.have_m15 && cmp.have_gold) {
     md << "- 15-bit M (M3/M4) Energy_min above every Gold family's, as in Table 4: **"
-       << (energy15_ok ? "yes" : "NO") << "** (M3/M4 smallest " << f(m15_energy, 3) << " V^2, Gold largest "
-       << f(gold_energy, 3) << " V^2)\n";
+       << (energy15_ok ? "yes" : "NO") << "** (M3/M4 smallest " << f(cmp.m15_energy, 3) << " V^2, Gold largest "
+       << f(cmp.gold_energy, 3) << " V^2)\n";
   }
-  md << explanations(scene, run.summaries, rank, energy15_ok, have_m15 && have_gold);
-  if (!figures.empty()) {
-    md << "\n## Figures\n\n";
-    md << "![Figure 13](" << figures[0] << ")\n\nFigure 13: filtered noise-free received bursts of every "
-       << fig13_family << " code at " << f(dmin * 1e3, 0) << " mm.\n\n";
-    md << "![Figure 14](" << figures[1] << ")\n\nFigure 14: u (eq. 10) per code (mean over distances and repeats).\n\n";
-    md << "![Figure 15](" << figures[2] << ")\n\nFigure 15: energy per code at "
-       << f(scene.range_l() * 1e3, 0) << " mm (mean over repeats).\n\n";
-    md << "![Figure 11](" << figures[3] << ")\n\nFigure 11 (bandpass curve, eqs. 7-8): rho(d), the correlation of "
-          "each code's filtered received burst at d with the one at "
-       << f(dmin * 1e3, 0)
-       << " mm, averaged over the group (noise-free bursts: the change of shape with distance, which here "
-          "comes from the air absorption alone; the paper's measured curve also carries noise).\n";
-  }
+  md << explanations(scene, run.summaries, cmp.rank, energy15_ok, cmp.have_m15 && cmp.have_gold);
+  if (!figures.empty()) md << figures_section(figures, fig13_family, dmin, scene);
   md << "\nData: `" << scene.name << "-per-code.csv`, `" << scene.name << "-fig13.csv`, `" << scene.name
      << "-rho-d.csv`, `" << scene.name << "-summary.json`.\n";
   write_file_atomic(stem + ".md", md.str());
@@ -502,11 +563,11 @@ int cmd_evaluate(const Args& args) {
 
   if (p.has("--json")) {
     nlohmann::json j;
-    j["families"] = tables;
-    j["rank_correlation"] = rank;
+    j["families"] = cmp.tables;
+    j["rank_correlation"] = cmp.rank;
     j["rho_d"] = rho_d;
-    j["checks"] = {{"vmax_equals_table6", vmax_ok},
-                   {"td_within_10_percent", td_ok},
+    j["checks"] = {{"vmax_equals_table6", cmp.vmax_ok},
+                   {"td_within_10_percent", cmp.td_ok},
                    {"m_energy_above_gold", energy_ok},
                    {"m15_energy_above_gold", energy15_ok},
                    {"td_clipped", td_clipped_total}};

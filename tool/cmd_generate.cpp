@@ -30,36 +30,34 @@ int cmd_generate(const Args& args) {
   p.flag("--no-sources", "write only the configuration-dependent files (tops, parameters, HLS configuration, manifest, README): no copies of rtl/ and hls/, no filelists, no .core; the form committed in generated/");
   p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
-  const auto config = p.get("--config");
-  const auto out = p.get("--out");
-  if (!config) throw InputError("option --config is required");
-  if (!out) throw InputError("option --out is required");
+  const std::string config = p.required("--config");
+  const std::string out = p.required("--out");
   {  // the folder is replaced as a whole: never replace a file, and fail before the design work
     std::error_code ec;
-    if (std::filesystem::exists(*out, ec) && !std::filesystem::is_directory(*out, ec)) {
-      throw InputError("option --out: '" + *out + "' exists and is not a folder; expected a folder");
+    if (std::filesystem::exists(out, ec) && !std::filesystem::is_directory(out, ec)) {
+      throw InputError("option --out: '" + out + "' exists and is not a folder; expected a folder");
     }
   }
   const Overrides overrides = parse_overrides(p.values("--set"));
-  const ReceiverConfig cfg = load_receiver_config(*config, overrides, p.has("--allow-out-of-spec"));
+  const ReceiverConfig cfg = load_receiver_config(config, overrides, p.has("--allow-out-of-spec"));
   warn_if_out_of_spec("generate", cfg);
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);
   std::map<std::string, std::string> files;
   try {
-    files = generate_hardware_files(design, p.get_or("--origin", *config));
+    files = generate_hardware_files(design, p.get_or("--origin", config));
   } catch (const InputError& e) {  // the system design's checks name system.* keys
-    throw InputError(locate_in_config(*config, e.what()));
+    throw InputError(locate_in_config(config, e.what()));
   }
   add_ip_package(files, design, p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl"),
                  std::string(build_info::kSourceDir) + "/hls", build_info::kVersion, "--rtl",
                  !p.has("--no-sources"));
   if (!overrides.empty()) files["config.yaml"] = receiver_config_yaml(cfg);  // re-run: --config DIR/config.yaml
-  write_hardware_files(files, *out);
+  write_hardware_files(files, out);
   const RealTimeBudget rt = realtime_budget(design);  // also in manifest.json
   if (!rt.real_time) std::cerr << "ranging generate: warning: " << rt.summary() << "\n";
   std::cout << "generated " << files.size() << " files for configuration '" << design.config.name
-            << "' in " << *out << "\n";
+            << "' in " << out << "\n";
   return 0;
 }
 

@@ -18,6 +18,7 @@
 #include "model/base/error.hpp"
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
+#include "tool/options.hpp"
 #include "tool/cli.hpp"
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
@@ -229,14 +230,11 @@ int cmd_simulate(const Args& args) {
   p.option("--out", "DIR", "output directory (created); default out/<scene name>");
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
-  p.option("--set", "KEY=VALUE", "override a key of the scene, a dotted YAML path (repeatable): noise.noise_v=0.01; receiver.config.KEY sets a key of its receiver configuration, e.g. receiver.config.correlator_fixed.chip_bits=18");
   p.option("--plot", "FILE.png", "draw the distance error against the true distance, per family");
-  p.flag("--quiet", "no progress bar");
-  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
+  add_scene_options(p);
   if (!p.parse(args)) return 0;
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
-  Scene scene = load_scene(p.positionals().at(0), parse_overrides(p.values("--set")), p.has("--allow-out-of-spec"));
-  warn_if_out_of_spec("simulate", scene.receiver.config);
+  Scene scene = load_scene_options(p, "simulate");
   if (p.has("--precision")) {
     const std::string prec = *p.get("--precision");
     if (prec != "float" && prec != "fixed" && prec != "rtl") {

@@ -160,9 +160,7 @@ int cmd_sweep(const Args& args) {
   p.flag("--no-plot", "skip DIR/front.png (no Python needed)");
   p.flag("--quiet", "no progress on stderr");
   if (!p.parse(args)) return 0;
-  const auto out_opt = p.get("--out");
-  if (!out_opt) throw InputError("option --out is required");
-  const std::string out = *out_opt;
+  const std::string out = p.required("--out");
   const int jobs = static_cast<int>(p.integer("--jobs", 1, 1, 256));
   int shard_i = 0, shard_n = 1;
   if (p.has("--shard")) {

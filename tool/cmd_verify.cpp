@@ -160,9 +160,7 @@ class Comparer {
 // distance d (several bursts in flight at once), ADC-quantized (as tb/tb_receiver_top.cpp).
 std::vector<std::int64_t> coded_stream(const ReceiverDesign& d, double distance, double noise, std::uint64_t seed,
                                        int period, double gain) {
-  ExcitationParams ex;
-  ex.carrier_hz = d.config.carrier_hz;
-  ex.cycles_per_chip = d.config.cycles_per_chip;
+  const ExcitationParams ex = receiver_excitation(d.config);
   const double fs = d.config.fs;
   const int eta = d.family.eta();
   ChannelParams ch;
@@ -274,10 +272,9 @@ int cmd_verify(const Args& args) {
   p.flag("--quiet", "no progress on stderr");
   if (!p.parse(args)) return 0;
   if (!p.positionals().empty()) throw InputError("unexpected argument '" + p.positionals().front() + "'");
-  const auto config = p.get("--config");
-  if (!config) throw InputError("option --config is required");
+  const std::string config = p.required("--config");
   const bool quiet = p.has("--quiet");
-  const ReceiverConfig cfg = load_receiver_config(*config);
+  const ReceiverConfig cfg = load_receiver_config(config);
   check_generatable(cfg);
   const ReceiverDesign design = design_receiver(cfg);
 
@@ -287,7 +284,7 @@ int cmd_verify(const Args& args) {
     throw InputError("option --rtl: '" + bo.rtl_dir + "' is not a folder");
   }
   bo.work_dir = p.has("--out") ? std::filesystem::path(*p.get("--out")) : default_work_dir("verify", cfg.name);
-  bo.origin = *config;
+  bo.origin = config;
   bo.trace = p.has("--trace");
   bo.quiet = quiet;
   const auto t0 = std::chrono::steady_clock::now();
@@ -356,7 +353,7 @@ int cmd_verify(const Args& args) {
     j["version"] = build_info::kVersion;
     j["git_commit"] = build_info::kGitCommit;
     j["config"] = cfg.name;
-    j["config_file"] = *config;
+    j["config_file"] = config;
     j["rtl"] = p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl");
     j["work_dir"] = rtl.work_dir().string();
     j["stages"] = nlohmann::json::array();
@@ -371,7 +368,7 @@ int cmd_verify(const Args& args) {
     j["pass"] = pass;
     std::cout << j.dump(2) << "\n";
   } else {
-    std::cout << "verify " << cfg.name << " (" << *config << "), RTL from "
+    std::cout << "verify " << cfg.name << " (" << config << "), RTL from "
               << p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl") << "\n";
     for (int i = 0; i < kStageCount; ++i) {
       std::cout << "  " << kStages[i] << std::string(16 - std::string(kStages[i]).size(), ' ')

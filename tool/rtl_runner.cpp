@@ -145,6 +145,7 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
                           " -f files.f --top-module receiver_top --Mdir " + quote(obj.string()) +
                           " -o verify_driver " + quote(driver_src.string());
   std::uint64_t key = fnv1a(cmd + read(driver_src));
+  for (const char* h : {"tb/verilator_harness.hpp", "tb/bits.hpp"}) key = fnv1a(read(fs::path(src) / h), key);
   std::istringstream list(read(work / "ip/files.f"));
   for (std::string line; std::getline(list, line);) key = fnv1a(read(work / "ip" / line), key);
   const std::string stamp = std::to_string(key);

@@ -102,6 +102,17 @@ void validate(const BandpassFixedConfig& config, const SosFilter& filter) {
   }
 }
 
+BandpassFixedLayout resolve_bandpass_layout(const SosFilter& filter, const BandpassFixedConfig& config) {
+  validate(config, filter);
+  return BandpassFixedLayout{quantize_sections(config, filter)};
+}
+
+std::vector<std::int64_t> BandpassFixedLayout::flat() const {
+  std::vector<std::int64_t> out;
+  for (const auto& c : coefficients) out.insert(out.end(), c.begin(), c.end());
+  return out;
+}
+
 int bandpass_min_acc_bits(const BandpassFixedConfig& config, const SosFilter& filter) {
   validate_words(config);
   require_sections(filter);
@@ -185,8 +196,7 @@ double BandpassFloat::execute(double x) {
 
 BandpassFixed::BandpassFixed(const SosFilter& filter, const BandpassFixedConfig& config)
     : filter_(filter), config_(config) {
-  validate(config, filter);
-  coef_ = quantize_sections(config, filter);
+  coef_ = resolve_bandpass_layout(filter, config).coefficients;  // validates
   input_fmt_ = FixedFormat{config.input_bits, config.input_bits - 1, true, Rounding::RoundHalfUp, Overflow::Saturate};
   data_fmt_ = FixedFormat{config.data_bits, config.data_frac, true, config.rounding, config.overflow};
   input_shift_ = config.data_frac - (config.input_bits - 1);
@@ -365,8 +375,8 @@ std::int64_t BandpassFixed::execute_raw(std::int64_t x_in) {
 
 double BandpassFixed::execute(double x) {
   require_finite("bandpass input sample", x);
-  const Fixed in(x, input_fmt_, &input_events_);
-  return std::ldexp(static_cast<double>(execute_raw(in.raw())), -config_.data_frac);
+  const std::int64_t in = quantize_input(x, config_.input_bits, &input_events_);  // the ADC model
+  return std::ldexp(static_cast<double>(execute_raw(in)), -config_.data_frac);
 }
 
 SosFilter BandpassFixed::quantized_filter() const {

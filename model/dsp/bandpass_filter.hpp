@@ -37,6 +37,17 @@ struct BandpassFixedConfig {  // every word length is configuration
 // every coefficient fits (field "section k b0" etc.), and acc_bits >= the minimum below.
 void validate(const BandpassFixedConfig& config, const SosFilter& filter);
 
+// The integers the fixed-point cascade computes with, derived without a filter object (what
+// the hardware generator and design_receiver need): per section {b0, b1, b2, a1, a2}, each
+// round(c 2^coef_frac) (ties away from zero) in a signed coef_bits word. Validates first
+// (validate() above: InputError naming the field); BandpassFixed holds exactly these.
+struct BandpassFixedLayout {
+  std::vector<std::vector<std::int64_t>> coefficients;
+  std::size_t sections() const { return coefficients.size(); }
+  std::vector<std::int64_t> flat() const;  // section-major: b0 b1 b2 a1 a2 of section 0, ...
+};
+BandpassFixedLayout resolve_bandpass_layout(const SosFilter& filter, const BandpassFixedConfig& config);
+
 // Smallest accumulator (signed bits) that holds sum |b_i| * max|x| + sum |a_i| * max|y| for
 // every section, with the quantized coefficients and the full ranges of the input and data
 // words. With it the accumulator cannot overflow for any input.

@@ -108,20 +108,28 @@ std::optional<Event> PeakDetectorFloat::flush() {
 
 // ---------------------------------------------------------------------------------------
 
-PeakDetectorFixed::PeakDetectorFixed(const DetectorConfig& cfg, const CorrelatorFixedLayout& layout,
-                                     const CorrelatorFixedConfig& corr)
-    : cfg_(cfg),
-      score_bits_(corr.score_bits),
-      decimation_(layout.decimation),
-      holdoff_(cfg.holdoff == -1 ? layout.window : cfg.holdoff) {
+PeakDetectorFixedLayout resolve_detector_layout(const DetectorConfig& cfg, const CorrelatorFixedLayout& layout,
+                                                const CorrelatorFixedConfig& corr) {
   validate(cfg);
-  const std::uint64_t cap = (std::uint64_t{1} << score_bits_) - 1;
-  thr_q_ = std::min<std::uint64_t>(
-      cap, static_cast<std::uint64_t>(std::llround(std::ldexp(cfg.threshold, score_bits_))));
+  PeakDetectorFixedLayout l;
+  l.holdoff = cfg.holdoff == -1 ? layout.window : cfg.holdoff;
+  const std::uint64_t cap = (std::uint64_t{1} << corr.score_bits) - 1;
+  l.threshold_q = std::min<std::uint64_t>(
+      cap, static_cast<std::uint64_t>(std::llround(std::ldexp(cfg.threshold, corr.score_bits))));
   // min_energy is in full-scale units^2: E_raw = E 2^(2 data_frac); norm = E_raw >> shift.
   const double e_raw = std::ldexp(cfg.min_energy, 2 * corr.data_frac - layout.energy_shift);
   require_in_range("detector.min_energy (in norm units)", e_raw, 0.0, 9.0e18);
-  min_norm_ = static_cast<std::uint64_t>(std::ceil(e_raw));
+  l.min_norm_q = static_cast<std::uint64_t>(std::ceil(e_raw));
+  return l;
+}
+
+PeakDetectorFixed::PeakDetectorFixed(const DetectorConfig& cfg, const CorrelatorFixedLayout& layout,
+                                     const CorrelatorFixedConfig& corr)
+    : cfg_(cfg), score_bits_(corr.score_bits), decimation_(layout.decimation) {
+  const PeakDetectorFixedLayout l = resolve_detector_layout(cfg, layout, corr);
+  thr_q_ = l.threshold_q;
+  min_norm_ = l.min_norm_q;
+  holdoff_ = l.holdoff;
 }
 
 void PeakDetectorFixed::reset() {

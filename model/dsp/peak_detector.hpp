@@ -82,6 +82,19 @@ class PeakDetectorFloat {
   std::optional<Candidate> cand_;
 };
 
+// The fixed-point detector's constants, derived without a detector object (what the hardware
+// generator needs). Validates cfg (InputError naming the field).
+//   threshold_q = min(2^score_bits - 1, round(threshold 2^score_bits))   on score
+//   min_norm_q  = ceil(min_energy 2^(2 data_frac - energy_shift))        on norm = E >> energy_shift
+//                 (InputError unless in [0, 9e18])
+//   holdoff     = cfg.holdoff, or the layout's energy window when -1     full-rate samples
+struct PeakDetectorFixedLayout {
+  std::uint64_t threshold_q = 0, min_norm_q = 0;
+  int holdoff = 0;
+};
+PeakDetectorFixedLayout resolve_detector_layout(const DetectorConfig& cfg, const CorrelatorFixedLayout& layout,
+                                                const CorrelatorFixedConfig& corr);
+
 class PeakDetectorFixed {
  public:
   PeakDetectorFixed(const DetectorConfig& cfg, const CorrelatorFixedLayout& layout,

@@ -1,5 +1,6 @@
 #include "model/dsp/quantize.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -24,6 +25,16 @@ std::int64_t quantize_coefficient(double value, int bits, int frac, const std::s
     throw InputError(os.str());
   }
   return static_cast<std::int64_t>(q);
+}
+
+std::int64_t quantize_input(double x, int bits, OverflowCounter* counter) {
+  const FixedFormat fmt{bits, bits - 1, true, Rounding::RoundHalfUp, Overflow::Saturate};
+  if (!std::isfinite(x)) throw InputError("receiver input: sample is not finite");
+  // x * 2^(bits-1) with 20 guard bits below the LSB, so the rounding sees the true fraction.
+  const double scaled = std::ldexp(x, bits - 1 + 20);
+  const double lim = std::ldexp(1.0, 100);
+  const int128_t raw = static_cast<int128_t>(std::clamp(std::floor(scaled), -lim, lim));
+  return fx_quantize(raw, bits - 1 + 20, fmt, counter);
 }
 
 }  // namespace ranging

@@ -119,10 +119,7 @@ namespace {
 // excitation, or its response through the TX and RX transducers and the bandpass filter,
 // trimmed where it has decayed below template_floor of its peak.
 std::vector<double> chip_waveform(const ReceiverConfig& cfg, const SosFilter& filter) {
-  ExcitationParams ex;
-  ex.carrier_hz = cfg.carrier_hz;
-  ex.cycles_per_chip = cfg.cycles_per_chip;
-  ex.fs = cfg.fs;
+  const ExcitationParams ex = receiver_excitation(cfg);
   const std::vector<std::uint8_t> one{1};
   std::vector<double> w = bpsk_excitation(one, ex);
   if (cfg.reference == "ideal") return w;
@@ -155,8 +152,8 @@ ReceiverDesign design_receiver(const ReceiverConfig& cfg_in) {
   d.family = code_family(cfg.family);
   d.filter = cfg.filter_order > 0 ? design_bandpass(cfg.filter, cfg.filter_type, cfg.filter_order)
                                   : design_bandpass(cfg.filter, cfg.filter_type);
-  // Constructing the fixed filter validates its word lengths against the coefficients.
-  BandpassFixed check(d.filter, cfg.bandpass);
+  // The fixed filter's word lengths against the coefficients (InputError naming the field).
+  validate(cfg.bandpass, d.filter);
   // The guard on what the integer coefficients implement (unstable / out of spec: refused).
   enforce_quantized_design(check_quantized_design(d), cfg);
 
@@ -227,14 +224,8 @@ ReceiverDesign design_receiver(const ReceiverConfig& cfg_in) {
 // ---------------------------------------------------------------------------------------
 // Receivers
 
-std::int64_t quantize_input(double x, int bits, OverflowCounter* counter) {
-  const FixedFormat fmt{bits, bits - 1, true, Rounding::RoundHalfUp, Overflow::Saturate};
-  if (!std::isfinite(x)) throw InputError("receiver input: sample is not finite");
-  // x * 2^(bits-1) with 20 guard bits below the LSB, so the rounding sees the true fraction.
-  const double scaled = std::ldexp(x, bits - 1 + 20);
-  const double lim = std::ldexp(1.0, 100);
-  const int128_t raw = static_cast<int128_t>(std::clamp(std::floor(scaled), -lim, lim));
-  return fx_quantize(raw, bits - 1 + 20, fmt, counter);
+ExcitationParams receiver_excitation(const ReceiverConfig& config, double amplitude) {
+  return ExcitationParams{config.carrier_hz, config.cycles_per_chip, config.fs, amplitude};
 }
 
 ReceiverFloat::ReceiverFloat(const ReceiverDesign& d)

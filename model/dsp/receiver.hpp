@@ -13,8 +13,10 @@
 #include "model/dsp/bandpass_filter.hpp"
 #include "model/dsp/codes.hpp"
 #include "model/dsp/correlator_bank.hpp"
+#include "model/dsp/excitation.hpp"
 #include "model/dsp/filter_design.hpp"
 #include "model/dsp/peak_detector.hpp"
+#include "model/dsp/quantize.hpp"  // quantize_input, the ADC model
 #include "model/dsp/transducer.hpp"
 
 namespace ranging {
@@ -92,8 +94,9 @@ struct ReceiverDesign {
 };
 ReceiverDesign design_receiver(const ReceiverConfig& cfg);
 
-// ADC model: x in full-scale units -> signed `bits` integer, round half up, saturate (counted).
-std::int64_t quantize_input(double x, int bits, OverflowCounter* counter);
+// The excitation the receiver is designed for (carrier_hz, cycles_per_chip and fs of the
+// configuration) at amplitude U: every stimulus built from a configuration starts here.
+ExcitationParams receiver_excitation(const ReceiverConfig& config, double amplitude = 1.0);
 
 class ReceiverFloat {
  public:

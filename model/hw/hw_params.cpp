@@ -93,13 +93,12 @@ std::vector<HwModuleParams> hardware_parameters(const ReceiverDesign& d) {
   check_generatable(d);
   const ReceiverConfig& c = d.config;
   const CorrelatorFixedLayout& l = d.layout;
-  const BandpassFixed bp(d.filter, c.bandpass);
+  const BandpassFixedLayout bp = resolve_bandpass_layout(d.filter, c.bandpass);
   std::vector<HwModuleParams> out;
 
   HwModuleParams sos{"bandpass_sos", {}};
-  std::vector<std::int64_t> coefs;
-  for (const auto& s : bp.coefficients()) coefs.insert(coefs.end(), s.begin(), s.end());
-  sos.params = {scalar("SECTIONS", static_cast<std::int64_t>(bp.coefficients().size())),
+  const std::vector<std::int64_t> coefs = bp.flat();
+  sos.params = {scalar("SECTIONS", static_cast<std::int64_t>(bp.sections())),
                 scalar("IN_W", c.bandpass.input_bits),
                 scalar("DATA_W", c.bandpass.data_bits),
                 scalar("DATA_FRAC", c.bandpass.data_frac),
@@ -154,7 +153,7 @@ std::vector<HwModuleParams> hardware_parameters(const ReceiverDesign& d) {
                  scalar("CODE_W", bits_for(l.codes))};  // m_code: j of the beat, 0-based
   out.push_back(bank);
 
-  const PeakDetectorFixed det(c.detector, l, c.correlator);
+  const PeakDetectorFixedLayout det = resolve_detector_layout(c.detector, l, c.correlator);
   HwModuleParams pd{"peak_detector", {}};
   pd.params = {scalar("CODES", l.codes),
                scalar("WEIGHTED_W", l.weighted_bits),
@@ -164,9 +163,9 @@ std::vector<HwModuleParams> hardware_parameters(const ReceiverDesign& d) {
                scalar("FRAC_W", c.detector.frac_bits),
                scalar("DECIM", l.decimation),
                scalar("TIME_W", time_w),
-               scalar("HOLDOFF", det.holdoff()),
-               packed("THRESHOLD", {static_cast<std::int64_t>(det.threshold_q())}, c.correlator.score_bits),
-               packed("MIN_NORM", {static_cast<std::int64_t>(det.min_norm_q())}, l.energy_bits),
+               scalar("HOLDOFF", det.holdoff),
+               packed("THRESHOLD", {static_cast<std::int64_t>(det.threshold_q)}, c.correlator.score_bits),
+               packed("MIN_NORM", {static_cast<std::int64_t>(det.min_norm_q)}, l.energy_bits),
                scalar("CODE_W", bits_for(l.codes))};
   out.push_back(pd);
   return out;

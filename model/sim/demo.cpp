@@ -63,10 +63,7 @@ std::vector<DemoRow> run_demo(const DemoParams& p,
 
   const ReceiverDesign design = design_receiver(p.receiver);
   const ReceiverConfig& rc = design.config;
-  ExcitationParams ex;
-  ex.carrier_hz = rc.carrier_hz;
-  ex.cycles_per_chip = rc.cycles_per_chip;
-  ex.fs = rc.fs;
+  const ExcitationParams ex = receiver_excitation(rc);
   const int window = design.family.length * rc.chip_samples();
   const std::size_t template_len = static_cast<std::size_t>(window + 2 * rc.chip_samples());
   const std::size_t tail = static_cast<std::size_t>(window) * 3 + 2000;
