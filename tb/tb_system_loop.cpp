@@ -5,8 +5,8 @@
 //   -> 12-bit ADC -> the adc_data pins -> receiver, ToF, UART line -> host frame decoder.
 // The channel of each received sample is computed from the drive the RTL has produced so far
 // (no precomputed schedule): the moving-transducer channel of model/sim/moving_channel.hpp on
-// the rotor geometry of model/sim/rotor.hpp (issue 15 §5), or the static channel of
-// model/sim/channel.hpp for the compensation test (issue 14 §6). Every frame is compared with
+// the rotor geometry of model/sim/rotor.hpp (issue 15 §5), or the same channel with fixed
+// transducers for the compensation test (issue 14 §6). Every frame is compared with
 // the model (ReceiverFixed + TofDistanceModel + calibrated_speed_register on the same ADC codes),
 // and the host side (model/hw/rotor_host.hpp) computes h from the frames.
 //
@@ -43,7 +43,6 @@
 #include "model/hw/hw_system.hpp"
 #include "model/hw/rotor_host.hpp"
 #include "model/hw/sound_speed_cal.hpp"
-#include "model/sim/channel.hpp"
 #include "model/sim/moving_channel.hpp"
 #include "model/sim/rotor.hpp"
 #include "tests/process.hpp"
@@ -378,37 +377,37 @@ TEST(SystemLoop, RotorCrossing) {
 // 2. Sound-velocity compensation in the RTL (issue 14 §6).
 
 // Static channels: burst 0 (code 1) goes over the reference path at the calibration distance,
-// every later burst over the measured path at d; the channel's speed of sound is c_air.
+// every later burst over the measured path at d; the channel's speed of sound is c_air. Both are
+// the moving channel with fixed transducers facing each other (on axis, 1/d spreading), each fed
+// its part of the RTL's drive.
+MovingLink static_link(double c_air, double d) {
+  MovingLink l;
+  l.tx = {[d](double) { return Vec3{0, 0, d}; }, [](double) { return Vec3{0, 0, 0}; }};
+  l.rx = {[](double) { return Vec3{0, 0, 0}; }, [](double) { return Vec3{0, 0, 0}; }};
+  l.c = c_air;
+  l.gain = 0.5;
+  return l;
+}
+
 class StaticSource {
  public:
-  StaticSource(double c_air, double d_ref, double d, const TransducerParams& tp) {
-    ref_.speed_of_sound = meas_.speed_of_sound = c_air;
-    ref_.distance_m = d_ref;
-    meas_.distance_m = d;
-    ref_.gain = meas_.gain = 0.5;
-    ref_.tx = ref_.rx = meas_.tx = meas_.rx = tp;
-  }
+  StaticSource(double c_air, double d_ref, double d, const TransducerParams& tp)
+      : ref_(static_link(c_air, d_ref), 0, sys().fs, tp, 0.005, 11u),
+        meas_(static_link(c_air, d), 0, sys().fs, tp, 0.0, 12u) {}
   double operator()(std::size_t k, const std::vector<std::int8_t>& drive) {
-    // integer delays from the drive so far, fractional part by the channel's own interpolator:
-    // propagate() of the drive split by path, rendered once the drive covers the flight.
     const std::size_t T = static_cast<std::size_t>(sys().period_t);
-    while (k >= y_.size()) {
-      const std::size_t r0 = y_.size(), blk = 256;
-      const double min_flight = std::min(ref_.distance_m, meas_.distance_m) / ref_.speed_of_sound * 5e6;
-      if (static_cast<double>(r0 + blk) + 40 > static_cast<double>(drive.size()) + min_flight) ++lookahead_violations;
-      std::vector<double> a(drive.size()), b(drive.size());
-      for (std::size_t j = 0; j < drive.size(); ++j) (j < T ? a : b)[j] = drive[j];
-      const auto ya = propagate(a, ref_, 5e6, r0 + blk);
-      const auto yb = propagate(b, meas_, 5e6, r0 + blk);
-      for (std::size_t j = r0; j < r0 + blk; ++j) y_.push_back(ya[j] + yb[j]);
+    while (a_.size() < drive.size()) {
+      const std::size_t j = a_.size();
+      a_.push_back(j < T ? drive[j] : 0);
+      b_.push_back(j < T ? 0 : drive[j]);
     }
-    return y_[k];
+    return ref_(k, a_) + meas_(k, b_);
   }
-  int lookahead_violations = 0;
+  int lookahead_violations() const { return ref_.lookahead_violations + meas_.lookahead_violations; }
 
  private:
-  ChannelParams ref_, meas_;
-  std::vector<double> y_;
+  MovingSource ref_, meas_;
+  std::vector<std::int8_t> a_, b_;
 };
 
 struct CalRun {
@@ -423,7 +422,7 @@ CalRun run_cal(double c_air, double d, bool calibrate) {
   StaticSource src(c_air, SystemOptions{}.calibration_distance_m, d, design().config.reference_transducer);
   CalRun r;
   r.loop = run_loop(n, std::ref(src), calibrate ? 10 : 0);
-  EXPECT_EQ(src.lookahead_violations, 0);
+  EXPECT_EQ(src.lookahead_violations(), 0);
   r.expected = model_frames(r.loop, calibrate);
   r.frames = check_frames(r.loop, r.expected);
   return r;
