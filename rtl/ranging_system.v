@@ -46,7 +46,10 @@ module ranging_system #(
   parameter integer C_FRAC = 16,
   parameter [31:0] C_INIT = 32'd4456448,
   parameter integer BAUD_DIV = 20,
-  parameter integer LED_HOLD = 1500000
+  parameter integer LED_HOLD = 1500000,
+  // Sound-velocity compensation (rtl/sound_speed_cal.v): the calibration distance in um, 0: none
+  // (the default and the committed bitstream: no logic, c_wr/c_value write C directly).
+  parameter integer CAL_DIST_UM = 0
 ) (
   input  wire clk, rst,
   // ADC
@@ -55,7 +58,9 @@ module ranging_system #(
   // transmitter H-bridge
   output wire hb_p, hb_n,
   output wire tx_active,
-  // measured speed of sound (compensation module): C format of tof_distance
+  // measured speed of sound (compensation module): C format of tof_distance. With
+  // CAL_DIST_UM > 0, c_wr with c_value == 0 (not a speed) is the calibration event instead:
+  // the next measurement is the reference path at CAL_DIST_UM, and C becomes D / ToF.
   input  wire c_wr,
   input  wire [31:0] c_value,
   // UART and status
@@ -113,13 +118,33 @@ module ranging_system #(
   wire [1:0] m_flags;
   wire [31:0] m_tof, m_distance;
   wire [SCORE_W-1:0] m_score, m_margin;
+  wire tof_c_wr;
+  wire [31:0] tof_c_value;
+  generate
+    if (CAL_DIST_UM > 0) begin : g_cal
+      wire cal_wr;
+      wire [31:0] cal_value;
+      /* verilator lint_off PINCONNECTEMPTY */
+      sound_speed_cal #(.TOF_W(32), .C_W(32), .SH(FRAC_W + C_FRAC), .CAL_DIST_UM(CAL_DIST_UM)) u_cal (
+        .clk(clk), .rst(rst), .arm(c_wr && c_value == 32'd0),
+        .meas_valid(m_valid && m_ready), .meas_flags(m_flags), .meas_tof(m_tof),
+        .c_wr(cal_wr), .c_value(cal_value), .armed(), .busy(), .sat_count()
+      );
+      /* verilator lint_on PINCONNECTEMPTY */
+      assign tof_c_wr = cal_wr || (c_wr && c_value != 32'd0);
+      assign tof_c_value = cal_wr ? cal_value : c_value;
+    end else begin : g_no_cal
+      assign tof_c_wr = c_wr;
+      assign tof_c_value = c_value;
+    end
+  endgenerate
   /* verilator lint_off PINCONNECTEMPTY */
   tof_distance #(.CODES(CODES), .CODE_W(CODE_W), .TIME_W(TIME_W), .FRAC_W(FRAC_W),
                  .PERIOD_T(PERIOD_T), .SCORE_W(SCORE_W), .OFF_W(OFF_W), .OFFSETS(OFFSETS),
                  .C_W(32), .C_FRAC(C_FRAC), .C_INIT(C_INIT), .TOF_W(32), .DIST_W(32)) u_tof (
     .clk(clk), .rst(rst),
     .burst_valid(burst_valid), .burst_code(burst_code), .burst_time(burst_time),
-    .c_wr(c_wr), .c_value(c_value), .c_current(),
+    .c_wr(tof_c_wr), .c_value(tof_c_value), .c_current(),
     .s_valid(event_valid), .s_ready(event_ready),
     .s_code(ev_code), .s_arrival(ev_arrival), .s_score(ev_score), .s_margin(ev_margin),
     .m_valid(m_valid), .m_ready(m_ready), .m_code(m_code), .m_flags(m_flags),
