@@ -190,6 +190,7 @@ int cmd_simulate(const Args& args) {
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
   p.option("--set", "KEY=VALUE", "override a key of the scene, a dotted YAML path (repeatable): noise.noise_v=0.01; receiver.config.KEY sets a key of its receiver configuration, e.g. receiver.config.correlator_fixed.chip_bits=18");
   p.flag("--quiet", "no progress bar");
+  p.option("--jobs", "N", "streams (distances, repeats, codes) simulated in parallel, 1..256 (the output does not depend on it; --precision rtl runs one)", "1");
   p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
   Scene scene = load_scene(p.positionals().at(0), parse_overrides(p.values("--set")), p.has("--allow-out-of-spec"));
@@ -214,8 +215,10 @@ int cmd_simulate(const Args& args) {
   if (scene.geometry.type == "rotor" && p.has("--write-captures")) {
     throw InputError("option --write-captures: not available for rotor scenes");
   }
+  const int jobs = static_cast<int>(p.integer("--jobs", 1, 1, 256));
   OutputDir out_dir(out, "option --out");  // checked before any work; removed again if the run fails
   SceneSimulator sim(scene);
+  sim.set_jobs(jobs);
   RtlSceneCheck rtl_check(p.get_or("--rtl", ""), "", p.has("--quiet"));
   if (rtl) rtl_check.attach(sim);
   // stdout is written only once the run has succeeded: a failing command prints nothing there.
