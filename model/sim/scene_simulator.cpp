@@ -720,23 +720,26 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     for (std::size_t b0 = 0; b0 < items.size(); b0 += batch) {
       const std::size_t b1 = std::min(items.size(), b0 + batch);
       std::vector<StreamOut> outs(b1 - b0);
-      std::vector<std::exception_ptr> errors(jobs);
+      std::vector<std::exception_ptr> errors(b1 - b0);  // per stream: the first in stream order is thrown
       std::atomic<std::size_t> next{b0};
       std::vector<std::thread> pool;
       for (std::size_t k = 0; k < jobs; ++k) {
         pool.emplace_back([&, k] {
-          try {
-            for (std::size_t i = next++; i < b1; i = next++) outs[i - b0] = one(items[i], *banks[k]);
-          } catch (...) {
-            errors[k] = std::current_exception();
+          for (std::size_t i = next++; i < b1; i = next++) {
+            try {
+              outs[i - b0] = one(items[i], *banks[k]);
+            } catch (...) {
+              errors[i - b0] = std::current_exception();
+            }
           }
         });
       }
       for (auto& t : pool) t.join();
-      for (auto& e : errors) {
-        if (e) std::rethrow_exception(e);
+      for (std::size_t i = b0; i < b1; ++i) {
+        // As with one thread: the streams before a failing one are emitted, then its error.
+        if (errors[i - b0]) std::rethrow_exception(errors[i - b0]);
+        emit(outs[i - b0], items[i]);
       }
-      for (std::size_t i = b0; i < b1; ++i) emit(outs[i - b0], items[i]);
     }
   }
   if (false_alarms) *false_alarms = fa;
