@@ -4,8 +4,10 @@
 #   the bandpass kernel vs scipy.signal.sosfilt on the same design and input
 #     (scripts/bench_sosfilt.py) and vs SystemC sc_fixed / sc_fix (bench/bench_fixed_point);
 #   the Verilator RTL of receiver_top vs the model (tb/bench_receiver_top);
+#   streaming decode of 10 M and 100 M-sample WAV captures (/usr/bin/time -v: CPU time, peak RSS);
+#   simulate --jobs 1 against --jobs 2 (wall time: the only clock that shows a parallel speedup);
 #   and the ratios. Rates are per second of CPU time (one core), so a busy machine does not
-#   scale them down.
+#   scale them down. BENCH_DECODE_SAMPLES="1e7 1e8" sets the decode lengths (disk: 4 bytes/sample).
 #   scripts/bench.sh [BUILD_DIR]      (default build/; configured with hardware and bench ON)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -29,6 +31,33 @@ if [[ -x $B/tb/bench_receiver_top ]]; then
 else
   echo "not built (configure with -DRANGING_BUILD_HARDWARE=ON)" >"$T/rtl.txt"
 fi
+# Streaming decode: a periodic Gold4 train (simulate --write-captures), tiled to N samples.
+printf '%s\n' "name: train" "medium: {temperature_c: 20}" "transducers: {}" "geometry: {distances_m: [0.5]}" \
+  "excitation: {family: Gold4, schedule: {mode: periodic, period_s: 0.0004, bursts: 27}}" \
+  "noise: {noise_v: 0.002, seed: 1}" >"$T/train.yaml"
+"$B"/tool/ranging simulate "$T/train.yaml" --out "$T/train" --write-captures --quiet >/dev/null
+: >"$T/decode.txt"
+for n in ${BENCH_DECODE_SAMPLES:-1e7 1e8}; do
+  $PY scripts/make_long_capture.py "$T/train/captures/Gold4_500mm_r1.wav" "$n" "$T/long.wav" 9
+  /usr/bin/time -v "$B"/tool/ranging decode "$T/long.wav" --json >"$T/long.out" 2>"$T/long.time"
+  $PY -c '
+import json, re, sys
+t = open(sys.argv[2]).read()
+g = lambda k: float(re.search(k + r".*?: ([0-9.]+)", t).group(1))
+cpu = g("User time") + g("System time")
+n = float(sys.argv[1])
+dets = len(json.load(open(sys.argv[3]))["detections"])
+rss = g("Maximum resident set size") / 1024
+print(f"{n:.0e} {cpu:.3f} {n / cpu / 1e6:.2f} {rss:.1f} {dets}")
+' "$n" "$T/long.time" "$T/long.out" >>"$T/decode.txt"
+  rm -f "$T/long.wav" "$T/long.json" "$T/long.out"
+done
+# Several cores: the default scene's streams (20 repeats: 900 streams) on 1 and 2 threads (same output: tests/test_parallel_streams).
+for j in 1 2; do
+  /usr/bin/time -f "%e %U %S" -o "$T/jobs$j.time" "$B"/tool/ranging simulate scenes/default.yaml \
+    --set geometry.repeats=20 --out "$T/jobs$j" --quiet --jobs $j >/dev/null
+done
+if cmp -s "$T/jobs1/measurements.csv" "$T/jobs2/measurements.csv"; then echo same; else echo DIFFERENT; fi >"$T/jobs.same"
 $PY - "$T" <<'PYEOF'
 import json, re, sys
 t = sys.argv[1]
@@ -66,6 +95,19 @@ print(f"  scipy.signal.sosfilt float64, 1 M samples       {s1m/1e6:8.2f}")
 kb = f["BM_BandpassFixedBlock"]
 print(f"  ratios: block kernel / sosfilt (4096) {kb/s4:.2f}, / sosfilt (1 M) {kb/s1m:.2f}, "
       f"/ sc_fixed {kb/sc:.0f}; per-sample kernel / sc_fixed {k/sc:.0f}")
+print()
+print("Streaming decode (ranging decode --json of a WAV train, /usr/bin/time -v; MS/s per CPU second):")
+print(f"  {'samples':>8s} {'CPU s':>8s} {'MS/s':>8s} {'peak RSS MB':>12s} {'bursts':>7s}")
+for line in open(f"{t}/decode.txt"):
+    n, cpu, rate, rss, dets = line.split()
+    print(f"  {n:>8s} {cpu:>8s} {rate:>8s} {rss:>12s} {dets:>7s}")
+print()
+w = {j: [float(v) for v in open(f"{t}/jobs{j}.time").read().split()] for j in (1, 2)}
+print("Several cores (simulate scenes/default.yaml --set geometry.repeats=20; wall time, user+sys CPU):")
+for j in (1, 2):
+    print(f"  --jobs {j}: wall {w[j][0]:.2f} s, CPU {w[j][1] + w[j][2]:.2f} s")
+print(f"  speedup (wall, jobs 1 / jobs 2): {w[1][0] / w[2][0]:.2f}; measurements.csv "
+      f"{open(f'{t}/jobs.same').read().strip()} (target >= 1.8 on 2 idle cores)")
 print()
 print("Verilator RTL (tb/bench_receiver_top):")
 for line in open(f"{t}/rtl.txt"):

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "model/sim/capture.hpp"
+#include "model/sim/capture_stream.hpp"
 #include "model/sim/capture_calibration.hpp"
 #include "model/sim/metrics.hpp"
 #include "model/dsp/codes.hpp"
@@ -123,11 +124,14 @@ int cmd_decode(const Args& args) {
   p.option("--distance", "M", "the distance of the --calibrate capture, 0.001..1000 m");
   p.option("--plot", "FILE.png", "draw the capture, the bandpass output and the bank's rho^2 per code with the detections");
   p.flag("--json", "machine-readable output");
+  p.option("--block-samples", "N", "the capture is streamed in blocks of N samples, 64..67108864 (memory, not results, depends on it)", "1048576");
   if (!p.parse(args)) return 0;
   const std::string path = p.positionals().at(0);
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
-  Capture cap = read_capture(path);
-  const CaptureMeta& meta = cap.meta;
+  const auto block = static_cast<std::size_t>(p.integer("--block-samples", 1 << 20, 64, 1 << 26));
+  // Streamed (model/sim/capture_stream.hpp): validated whole at open, then read in blocks.
+  CaptureSource cap(path);
+  const CaptureMeta& meta = cap.meta();
   const std::string meta_src = "capture metadata (" + (meta.source.empty() ? path : meta.source) + ")";
 
   std::string family, family_source;
@@ -172,17 +176,17 @@ int cmd_decode(const Args& args) {
 
   // The receiver needs an integer number of samples per carrier cycle.
   constexpr double carrier = 200e3;
-  auto check_rate = [&](const Capture& k, const std::string& file) {
-    const double ratio = k.sample_rate / carrier;
+  auto check_rate = [&](double rate, const std::string& file) {
+    const double ratio = rate / carrier;
     if (std::abs(ratio - std::round(ratio)) > 1e-3 * ratio || std::round(ratio) < 4) {
       std::ostringstream os;
-      os << file << ": sample rate " << k.sample_rate << " Hz is " << ratio
+      os << file << ": sample rate " << rate << " Hz is " << ratio
          << " samples per 200 kHz carrier cycle; the receiver needs an integer >= 4 (e.g. 1, 2.5, 5 or 10 MS/s)";
       throw InputError(os.str());
     }
     return std::round(ratio) * carrier;
   };
-  const double fs = check_rate(cap, path);
+  const double fs = check_rate(cap.sample_rate(), path);
 
   std::ostringstream yaml;
   yaml.precision(17);
@@ -193,26 +197,26 @@ int cmd_decode(const Args& args) {
   warn_if_out_of_spec("decode", scene.receiver.config);
   const CodeFamily fam = code_family(family);
   const std::size_t burst = static_cast<std::size_t>(fam.length + 3) * static_cast<std::size_t>(scene.receiver.config.chip_samples());
-  auto check_len = [&](const Capture& k, const std::string& file) {
-    if (k.samples.size() < burst) {
+  auto check_len = [&](std::size_t samples, const std::string& file) {
+    if (samples < burst) {
       std::ostringstream os;
-      os << file << ": too short: " << k.samples.size() << " samples (" << k.samples.size() / fs * 1e6
+      os << file << ": too short: " << samples << " samples (" << samples / fs * 1e6
          << " us) hold less than one burst of " << family << " (" << burst << " samples, " << burst / fs * 1e6 << " us)";
       throw InputError(os.str());
     }
   };
-  check_len(cap, path);
+  check_len(cap.size(), path);
   SceneSimulator sim(scene);
 
   std::optional<LatencyCalibration> cal;
   if (p.has("--calibrate")) {
     const std::string cal_path = *p.get("--calibrate");
     Capture k = read_capture(cal_path);
-    if (std::abs(check_rate(k, cal_path) - fs) > 1e-6 * fs) {
+    if (std::abs(check_rate(k.sample_rate, cal_path) - fs) > 1e-6 * fs) {
       throw InputError("option --calibrate: " + cal_path + " is sampled at " + std::to_string(k.sample_rate) +
-                       " Hz, the capture at " + std::to_string(cap.sample_rate) + " Hz");
+                       " Hz, the capture at " + std::to_string(cap.sample_rate()) + " Hz");
     }
-    check_len(k, cal_path);
+    check_len(k.samples.size(), cal_path);
     std::vector<Detection> kd;
     // The calibration capture's own burst period (its metadata) if it has one, else the capture's.
     const double kperiod = k.meta.period_s ? *k.meta.period_s : period.value;
@@ -223,11 +227,13 @@ int cmd_decode(const Args& args) {
   }
 
   std::vector<Detection> dets, below;
-  for (auto d : sim.decode(family, cap.samples, cap.t0, period.value)) {
+  for (auto d : sim.decode_stream(family, cap, period.value, block)) {
     if (cal) d.tof_s = cal->correct(d.code, d.tof_s);
     (d.rho_max >= min_rho ? dets : below).push_back(d);
   }
-  if (p.has("--plot")) plot_decode(*p.get("--plot"), scene, family, cap, fs, dets, below);
+  if (p.has("--plot")) {  // the picture needs the whole capture in memory (decoding does not)
+    plot_decode(*p.get("--plot"), scene, family, read_capture(path), fs, dets, below);
+  }
   const bool known = meta.code_sent && *meta.code_sent > 0;
   auto det_json = [&](const Detection& d) {
     nlohmann::json o = {{"code", d.code}, {"tof_s", d.tof_s}, {"distance_m", d.tof_s * c.value},
@@ -242,7 +248,7 @@ int cmd_decode(const Args& args) {
 
   if (p.has("--json")) {
     nlohmann::json j;
-    j["sample_rate"] = cap.sample_rate;
+    j["sample_rate"] = cap.sample_rate();
     j["family"] = family;
     j["family_source"] = family_source;
     j["speed_of_sound"] = c.value;
@@ -269,8 +275,8 @@ int cmd_decode(const Args& args) {
     std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s\n",
                  family.c_str(), family_source.c_str(), c.value, c.source.c_str(), period.value,
                  period.source.c_str());
-    std::printf("%s: %zu samples at %.6g MS/s, family %s, c = %.2f m/s%s\n", path.c_str(), cap.samples.size(),
-                cap.sample_rate / 1e6, family.c_str(), c.value, cal ? ", latency calibrated" : "");
+    std::printf("%s: %zu samples at %.6g MS/s, family %s, c = %.2f m/s%s\n", path.c_str(), cap.size(),
+                cap.sample_rate() / 1e6, family.c_str(), c.value, cal ? ", latency calibrated" : "");
     std::printf("%5s %12s %12s %8s %8s\n", "code", "tof_us", "distance_mm", "rho_max", "margin");
     for (const auto& d : dets) {
       std::printf("%5d %12.3f %12.3f %8.4f %8.4f\n", d.code, d.tof_s * 1e6, d.tof_s * c.value * 1e3, d.rho_max,

@@ -231,6 +231,7 @@ int cmd_simulate(const Args& args) {
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
   p.option("--plot", "FILE.png", "draw the distance error against the true distance, per family");
+  p.option("--jobs", "N", "streams (distances, repeats, codes) simulated in parallel, 1..256 (the output does not depend on it; --precision rtl runs one)", "1");
   add_scene_options(p);
   if (!p.parse(args)) return 0;
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
@@ -258,8 +259,10 @@ int cmd_simulate(const Args& args) {
   if (scene.geometry.type == "rotor" && p.has("--write-captures")) {
     throw InputError("option --write-captures: not available for rotor scenes");
   }
+  const int jobs = static_cast<int>(p.integer("--jobs", 1, 1, 256));
   OutputDir out_dir(out, "option --out");  // checked before any work; removed again if the run fails
   SceneSimulator sim(scene);
+  sim.set_jobs(jobs);
   RtlSceneCheck rtl_check(p.get_or("--rtl", ""), "", p.has("--quiet"));
   if (rtl) rtl_check.attach(sim);
   // stdout is written only once the run has succeeded: a failing command prints nothing there.

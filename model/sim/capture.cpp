@@ -15,6 +15,7 @@
 #include "model/base/atomic_file.hpp"
 #include "model/base/error.hpp"
 #include "model/base/input_file.hpp"
+#include "model/sim/capture_stream.hpp"
 
 namespace ranging {
 namespace {
@@ -141,84 +142,101 @@ CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& 
   return m;
 }
 
+CsvCaptureScan::CsvCaptureScan(std::string origin) : origin_(std::move(origin)) {}
+
+bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
+  ++lineno_;
+  if (trim(text).empty()) {
+    if (data_) fail_at(origin_, lineno_, "empty line inside the data rows");
+    return false;
+  }
+  const auto cells = split_cells(text);
+  double first = 0;
+  const bool numeric_first = !cells.empty() && parse_number(cells[0], first);
+  if (!data_ && !numeric_first) {  // header line (before the first data row); metadata keys
+    if (cells.size() >= 2 && cells[0] == "Record Length" && parse_number(cells[1], first)) {
+      record_length_ = first;
+      record_line_ = lineno_;
+    }
+    if (cells.size() >= 2) read_meta_line(meta_, cells[0], cells[1], origin_, lineno_);
+    return false;
+  }
+  if (!data_) first_data_line_ = lineno_;
+  data_ = true;
+  if (cells.size() < 2) fail_at(origin_, lineno_, "expected 'time,voltage', found one column");
+  double val[2];
+  for (int c = 0; c < 2; ++c) {
+    const std::string& cell = cells[static_cast<std::size_t>(c)];
+    if (!parse_number(cell, val[c])) {
+      fail_at(origin_, lineno_, std::string(c == 0 ? "time" : "voltage") + " column: '" + cell + "' is not a number");
+    }
+    if (!std::isfinite(val[c])) {
+      fail_at(origin_, lineno_, std::string(c == 0 ? "time" : "voltage") + " column: '" + cell +
+                                    "' is not finite (NaN or Inf)");
+    }
+  }
+  if (rows_ > 0 && !(val[0] > t_last_)) {
+    fail_at(origin_, lineno_, "time does not increase (" + cells[0] + " after the previous row)");
+  }
+  if (rows_ == 0) t_first_ = val[0];
+  t_last_ = val[0];
+  last_data_line_ = lineno_;
+  ++rows_;
+  t = val[0];
+  v = val[1];
+  return true;
+}
+
+void CsvCaptureScan::finish() {
+  if (record_length_ >= 0 && record_length_ != static_cast<double>(rows_)) {
+    std::ostringstream os;
+    os << "Record Length: the header declares " << record_length_ << " rows, the file holds " << rows_
+       << " data rows (truncated?); valid: the number of data rows";
+    fail_at(origin_, record_line_, os.str());
+  }
+  if (rows_ == 0) fail_at(origin_, lineno_, "no data rows (empty capture; expected rows 'time_s,volts')");
+  if (rows_ < 2) fail_at(origin_, lineno_, "one data row: a capture needs at least two samples");
+  const double span = t_last_ - t_first_;
+  dt_ = span / static_cast<double>(rows_ - 1);
+  if (!std::isfinite(span) || !(dt_ > 0) || !(1.0 / dt_ >= 1.0 && 1.0 / dt_ <= 1e12)) {
+    std::ostringstream os;
+    os.precision(9);
+    os << "time: a span of " << span << " s over " << rows_ - 1 << " steps is not a sample rate in [1 Hz, 1e12 Hz]";
+    fail_at(origin_, last_data_line_, os.str());
+  }
+  if (!meta_.empty()) meta_.source = "csv header";
+}
+
+void CsvCaptureScan::check_grid(std::size_t n, double t, std::size_t line) const {
+  const double grid = t_first_ + dt_ * static_cast<double>(n);
+  if (std::abs(t - grid) > 0.02 * dt_) {
+    std::ostringstream os;
+    os.precision(9);
+    os << "uneven sampling: time " << t << " s is " << (t - grid) / dt_ << " steps off the uniform grid of step "
+       << dt_ << " s (tolerance 0.02 step)";
+    fail_at(origin_, line, os.str());
+  }
+}
+
 Capture parse_capture_csv(const std::string& text, const std::string& origin) {
-  Capture c;
+  CsvCaptureScan scan(origin);
   std::vector<double> t, v;
   std::vector<std::size_t> lines;
   std::stringstream in(text);
   std::string line;
-  std::size_t lineno = 0;
-  bool data = false;
-  double record_length = -1;  // the header's "Record Length" (rows the scope says it wrote)
-  std::size_t record_line = 0;
+  double tv = 0, vv = 0;
   while (std::getline(in, line)) {
-    ++lineno;
-    if (trim(line).empty()) {
-      if (data) fail_at(origin, lineno, "empty line inside the data rows");
-      continue;
-    }
-    const auto cells = split_cells(line);
-    double first = 0;
-    const bool numeric_first = !cells.empty() && parse_number(cells[0], first);
-    if (!data && !numeric_first) {  // header line (before the first data row); metadata keys
-      if (cells.size() >= 2 && cells[0] == "Record Length" && parse_number(cells[1], first)) {
-        record_length = first;
-        record_line = lineno;
-      }
-      if (cells.size() >= 2) read_meta_line(c.meta, cells[0], cells[1], origin, lineno);
-      continue;
-    }
-    data = true;
-    if (cells.size() < 2) fail_at(origin, lineno, "expected 'time,voltage', found one column");
-    double val[2];
-    for (int c = 0; c < 2; ++c) {
-      const std::string& cell = cells[static_cast<std::size_t>(c)];
-      if (!parse_number(cell, val[c])) {
-        fail_at(origin, lineno, std::string(c == 0 ? "time" : "voltage") + " column: '" + cell +
-                                    "' is not a number");
-      }
-      if (!std::isfinite(val[c])) {
-        fail_at(origin, lineno, std::string(c == 0 ? "time" : "voltage") + " column: '" + cell +
-                                    "' is not finite (NaN or Inf)");
-      }
-    }
-    if (!t.empty() && !(val[0] > t.back())) {
-      fail_at(origin, lineno, "time does not increase (" + cells[0] + " after the previous row)");
-    }
-    t.push_back(val[0]);
-    v.push_back(val[1]);
-    lines.push_back(lineno);
+    if (!scan.line(line, tv, vv)) continue;
+    t.push_back(tv);
+    v.push_back(vv);
+    lines.push_back(scan.lineno());
   }
-  if (record_length >= 0 && record_length != static_cast<double>(t.size())) {
-    std::ostringstream os;
-    os << "Record Length: the header declares " << record_length << " rows, the file holds " << t.size()
-       << " data rows (truncated?); valid: the number of data rows";
-    fail_at(origin, record_line, os.str());
-  }
-  if (t.empty()) fail_at(origin, lineno, "no data rows (empty capture; expected rows 'time_s,volts')");
-  if (t.size() < 2) fail_at(origin, lineno, "one data row: a capture needs at least two samples");
-  const double span = t.back() - t.front();
-  const double dt = span / static_cast<double>(t.size() - 1);
-  if (!std::isfinite(span) || !(dt > 0) || !(1.0 / dt >= 1.0 && 1.0 / dt <= 1e12)) {
-    std::ostringstream os;
-    os.precision(9);
-    os << "time: a span of " << span << " s over " << t.size() - 1
-       << " steps is not a sample rate in [1 Hz, 1e12 Hz]";
-    fail_at(origin, lines.back(), os.str());
-  }
-  for (std::size_t n = 0; n < t.size(); ++n) {
-    const double grid = t.front() + dt * static_cast<double>(n);
-    if (std::abs(t[n] - grid) > 0.02 * dt) {
-      std::ostringstream os;
-      os.precision(9);
-      os << "uneven sampling: time " << t[n] << " s is " << (t[n] - grid) / dt
-         << " steps off the uniform grid of step " << dt << " s (tolerance 0.02 step)";
-      fail_at(origin, lines[n], os.str());
-    }
-  }
-  c.sample_rate = 1.0 / dt;
-  c.t0 = t.front();
-  if (!c.meta.empty()) c.meta.source = "csv header";
+  scan.finish();
+  for (std::size_t n = 0; n < t.size(); ++n) scan.check_grid(n, t[n], lines[n]);
+  Capture c;
+  c.sample_rate = scan.sample_rate();
+  c.t0 = scan.t0();
+  c.meta = scan.meta();
   c.samples = std::move(v);
   return c;
 }
@@ -240,9 +258,11 @@ std::uint16_t le16(const std::string& b, std::size_t at) {
 
 }  // namespace
 
-Capture parse_capture_wav(const std::string& b, const std::string& origin) {
-  if (b.empty()) fail_wav(origin, 0, "empty file");
-  if (b.size() < 12 || b.compare(0, 4, "RIFF") != 0 || b.compare(8, 4, "WAVE") != 0) {
+WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::size_t)>& bytes,
+                           std::size_t file_size, const std::string& origin) {
+  if (file_size == 0) fail_wav(origin, 0, "empty file");
+  const std::string head = bytes(0, std::min<std::size_t>(12, file_size));
+  if (head.size() < 12 || head.compare(0, 4, "RIFF") != 0 || head.compare(8, 4, "WAVE") != 0) {
     fail_wav(origin, 0, "not a RIFF/WAVE file");
   }
   std::size_t at = 12;
@@ -250,21 +270,23 @@ Capture parse_capture_wav(const std::string& b, const std::string& origin) {
   std::uint16_t format = 0, channels = 0, bits = 0;
   std::uint32_t rate = 0;
   while (true) {
-    if (at + 8 > b.size()) {
+    if (at + 8 > file_size) {
       fail_wav(origin, at, have_fmt ? "truncated: no data chunk" : "truncated: no fmt chunk");
     }
-    const std::string id = b.substr(at, 4);
-    const std::uint32_t size = le32(b, at + 4);
+    const std::string ch = bytes(at, 8);
+    const std::string id = ch.substr(0, 4);
+    const std::uint32_t size = le32(ch, 4);
     const std::size_t body = at + 8;
     if (id == "fmt ") {
-      if (size < 16 || body + size > b.size()) fail_wav(origin, at, "truncated or short fmt chunk");
-      format = le16(b, body);
-      channels = le16(b, body + 2);
-      rate = le32(b, body + 4);
-      bits = le16(b, body + 14);
+      if (size < 16 || body + size > file_size) fail_wav(origin, at, "truncated or short fmt chunk");
+      const std::string b = bytes(body, std::min<std::size_t>(size, 40));
+      format = le16(b, 0);
+      channels = le16(b, 2);
+      rate = le32(b, 4);
+      bits = le16(b, 14);
       if (format == 0xFFFE) {
         if (size < 40) fail_wav(origin, at, "WAVE_FORMAT_EXTENSIBLE fmt chunk shorter than 40 bytes");
-        format = le16(b, body + 24);  // the sub-format GUID starts with the format code
+        format = le16(b, 24);  // the sub-format GUID starts with the format code
       }
       have_fmt = true;
     } else if (id == "data") {
@@ -277,41 +299,73 @@ Capture parse_capture_wav(const std::string& b, const std::string& origin) {
         fail_wav(origin, at, "unsupported sample format (format " + std::to_string(format) + ", " +
                                  std::to_string(bits) + " bits); valid: 16/24-bit PCM, 32-bit float");
       }
-      const std::size_t bytes = bits / 8u, frame = bytes * channels;
-      if (body + size > b.size()) {
+      WavLayout w;
+      w.rate = rate;
+      w.flt = flt;
+      w.bits = bits;
+      w.frame = static_cast<std::size_t>(bits / 8u) * channels;
+      w.body = body;
+      w.chunk_at = at;
+      if (body + size > file_size) {
         fail_wav(origin, at, "truncated: the data chunk declares " + std::to_string(size) +
-                                 " bytes, the file holds " + std::to_string(b.size() - body));
+                                 " bytes, the file holds " + std::to_string(file_size - body));
       }
-      if (size % frame != 0) fail_wav(origin, at, "truncated: data size is not a whole number of frames");
-      Capture c;
-      c.sample_rate = rate;
-      const std::size_t n = size / frame;
-      c.samples.resize(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const std::size_t p = body + i * frame;
-        double x;
-        if (flt) {
-          const std::uint32_t u = le32(b, p);
-          float f;
-          std::memcpy(&f, &u, sizeof f);
-          if (!std::isfinite(f)) fail_wav(origin, p, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
-          x = f;
-        } else if (bits == 16) {
-          x = static_cast<std::int16_t>(le16(b, p)) / 32768.0;
-        } else {
-          std::int32_t s = static_cast<std::int32_t>(static_cast<unsigned char>(b[p]) |
-                                                     (static_cast<unsigned char>(b[p + 1]) << 8) |
-                                                     (static_cast<unsigned char>(b[p + 2]) << 16));
-          if (s & 0x800000) s -= 0x1000000;
-          x = s / 8388608.0;
-        }
-        c.samples[i] = x;
-      }
-      if (n < 2) fail_wav(origin, at, "the data chunk holds fewer than two samples");
-      return c;
+      if (size % w.frame != 0) fail_wav(origin, at, "truncated: data size is not a whole number of frames");
+      w.n = size / w.frame;
+      return w;
     }
     // RIFF chunks are padded to an even size.
     at = body + size + (size & 1u);
+  }
+}
+
+double wav_sample(const char* p, const WavLayout& w, const std::string& origin, std::size_t i) {
+  if (w.flt) {
+    std::uint32_t u = 0;
+    for (int k = 3; k >= 0; --k) u = (u << 8) | static_cast<unsigned char>(p[k]);
+    float f;
+    std::memcpy(&f, &u, sizeof f);
+    if (!std::isfinite(f)) fail_wav(origin, w.body + i * w.frame, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
+    return f;
+  }
+  if (w.bits == 16) {
+    return static_cast<std::int16_t>(static_cast<std::uint16_t>(static_cast<unsigned char>(p[0]) |
+                                                                (static_cast<unsigned char>(p[1]) << 8))) /
+           32768.0;
+  }
+  std::int32_t s = static_cast<std::int32_t>(static_cast<unsigned char>(p[0]) | (static_cast<unsigned char>(p[1]) << 8) |
+                                             (static_cast<unsigned char>(p[2]) << 16));
+  if (s & 0x800000) s -= 0x1000000;
+  return s / 8388608.0;
+}
+
+Capture parse_capture_wav(const std::string& b, const std::string& origin) {
+  const WavLayout w = parse_wav_layout([&](std::size_t at, std::size_t len) { return b.substr(at, len); }, b.size(),
+                                       origin);
+  Capture c;
+  c.sample_rate = w.rate;
+  c.samples.resize(w.n);
+  for (std::size_t i = 0; i < w.n; ++i) c.samples[i] = wav_sample(b.data() + w.body + i * w.frame, w, origin, i);
+  if (w.n < 2) fail_wav(origin, w.chunk_at, "the data chunk holds fewer than two samples");
+  return c;
+}
+
+void merge_capture_sidecar(CaptureMeta& o, const std::string& path) {
+  const std::string sidecar = path.substr(0, path.size() - 4) + ".json";
+  std::ifstream js(sidecar, std::ios::binary);
+  if (js) {
+    std::stringstream sj;
+    sj << js.rdbuf();
+    const CaptureMeta m = parse_capture_meta_json(sj.str(), sidecar);
+    const bool had = !o.empty();
+    if (!o.scene) o.scene = m.scene;
+    if (!o.family) o.family = m.family;
+    if (!o.code_sent) o.code_sent = m.code_sent;
+    if (!o.true_distance_m) o.true_distance_m = m.true_distance_m;
+    if (!o.speed_of_sound) o.speed_of_sound = m.speed_of_sound;
+    if (!o.sample_rate) o.sample_rate = m.sample_rate;
+    if (!o.period_s) o.period_s = m.period_s;
+    if (!m.empty()) o.source = had ? o.source + " and " + sidecar : sidecar;
   }
 }
 
@@ -324,23 +378,7 @@ Capture read_capture(const std::string& path) {
   }
   const std::string bytes = read_input_file(path, "capture file", std::size_t{1} << 30);
   Capture c = ext == "csv" ? parse_capture_csv(bytes, path) : parse_capture_wav(bytes, path);
-  const std::string sidecar = path.substr(0, path.size() - 4) + ".json";
-  std::ifstream js(sidecar, std::ios::binary);
-  if (js) {
-    std::stringstream sj;
-    sj << js.rdbuf();
-    const CaptureMeta m = parse_capture_meta_json(sj.str(), sidecar);
-    CaptureMeta& o = c.meta;
-    const bool had = !o.empty();
-    if (!o.scene) o.scene = m.scene;
-    if (!o.family) o.family = m.family;
-    if (!o.code_sent) o.code_sent = m.code_sent;
-    if (!o.true_distance_m) o.true_distance_m = m.true_distance_m;
-    if (!o.speed_of_sound) o.speed_of_sound = m.speed_of_sound;
-    if (!o.sample_rate) o.sample_rate = m.sample_rate;
-    if (!o.period_s) o.period_s = m.period_s;
-    if (!m.empty()) o.source = had ? o.source + " and " + sidecar : sidecar;
-  }
+  merge_capture_sidecar(c.meta, path);
   return c;
 }
 

@@ -5,6 +5,7 @@
 #include <complex>
 #include <new>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <string>
 
@@ -41,6 +42,13 @@ LagRho pearson_over_lags(std::span<const double> x, std::span<const double> t, l
   return best;
 }
 
+// FFTW's planner is not thread-safe (only fftw_execute is): plans are made and destroyed under
+// this lock, so PearsonBanks of different threads (sweep --jobs, SceneSimulator::set_jobs) coexist.
+static std::mutex& fftw_planner_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 struct PearsonBank::Plan {
   std::size_t nfft = 0;
   double* in = nullptr;
@@ -50,6 +58,7 @@ struct PearsonBank::Plan {
   fftw_plan fwd = nullptr, inv = nullptr;
   std::vector<std::vector<std::complex<double>>> tspec;  // conj FFT of each centred template
   ~Plan() {
+    const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     if (fwd) fftw_destroy_plan(fwd);
     if (inv) fftw_destroy_plan(inv);
     fftw_free(in);
@@ -94,8 +103,11 @@ PearsonBank::Plan& PearsonBank::plan(std::size_t nfft) {
   p->prod = fftw_alloc_complex(nc);
   if (!p->in || !p->out || !p->spec || !p->prod) throw std::bad_alloc();
   const int n = static_cast<int>(nfft);
-  p->fwd = fftw_plan_dft_r2c_1d(n, p->in, p->spec, FFTW_ESTIMATE);
-  p->inv = fftw_plan_dft_c2r_1d(n, p->prod, p->out, FFTW_ESTIMATE);
+  {
+    const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    p->fwd = fftw_plan_dft_r2c_1d(n, p->in, p->spec, FFTW_ESTIMATE);
+    p->inv = fftw_plan_dft_c2r_1d(n, p->prod, p->out, FFTW_ESTIMATE);
+  }
   for (const auto& t : t_) {
     std::fill(p->in, p->in + nfft, 0.0);
     std::copy(t.begin(), t.end(), p->in);
@@ -298,6 +310,7 @@ StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std
   d.last = last;
   d.seconds = static_cast<double>(last - first) / fs;
   d.clipped = !(ended && began);
+  d.ended_forward = ended;
   return d;
 }
 

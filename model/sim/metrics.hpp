@@ -106,6 +106,8 @@ struct StreamDuration {
   double seconds = 0;
   double threshold = 0, noise_rms = 0;
   bool clipped = false, noise_limited = false;
+  bool ended_forward = false;  // the forward scan found `guard` quiet samples before hi (hi did not cut it):
+                               // then any larger hi gives the same result (streaming decode relies on it)
 };
 StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std::size_t hi, std::size_t p0,
                                   std::size_t p1, std::size_t guard, double fs);

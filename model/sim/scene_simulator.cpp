@@ -1,6 +1,8 @@
 #include "model/sim/scene_simulator.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -9,8 +11,10 @@
 #include <numbers>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include "model/sim/capture.hpp"
+#include "model/sim/capture_stream.hpp"
 #include "model/sim/channel.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
@@ -211,8 +215,11 @@ struct SceneSimulator::Link {
   }
 
   // Runs the receiver of the scene's precision over x (volts); returns its events and the
-  // float bandpass output in volts.
-  std::vector<Event> receive(const std::vector<double>& volts, double scale, std::vector<double>& filtered) {
+  // float bandpass output in volts. The fixed receiver's saturations/wraps (input included) are
+  // added to *ovf (default: this link's counter). The fixed receiver runs through its block API
+  // (ReceiverFixed::execute_block, bit-exact with execute_raw per sample: tests/test_block_api).
+  std::vector<Event> receive(const std::vector<double>& volts, double scale, std::vector<double>& filtered,
+                             std::uint64_t* ovf = nullptr) {
     std::vector<Event> ev;
     filtered.resize(volts.size());
     const double inv = 1.0 / scale;
@@ -227,25 +234,56 @@ struct SceneSimulator::Link {
       ReceiverFixed rx(design);
       BandpassFloat bp(design.filter);
       const bool observed = observer && *observer;
-      std::vector<std::int64_t> raw;
-      std::vector<EventFixed> raw_events;
       OverflowCounter adc;
-      for (std::size_t n = 0; n < volts.size(); ++n) {
-        const double x = std::clamp(volts[n] * inv, -1.0, 1.0);
-        if (observed) {  // the same quantization as ReceiverFixed::execute(double)
-          raw.push_back(quantize_input(x, design.config.bandpass.input_bits, &adc));
-          if (auto e = rx.execute_raw(raw.back())) {
-            raw_events.push_back(*e);
-            ev.push_back(rx.to_float(*e));
-          }
-        } else if (auto e = rx.execute(x)) {
-          ev.push_back(*e);
+      // The same quantization as ReceiverFixed::execute(double), a chunk at a time (the whole
+      // stream's codes are kept only for the observer).
+      constexpr std::size_t kChunk = 4096;
+      std::vector<std::int64_t> raw(observed ? volts.size() : std::min(kChunk, volts.size()));
+      std::vector<EventFixed> raw_events;
+      for (std::size_t n0 = 0; n0 < volts.size(); n0 += kChunk) {
+        const std::size_t n1 = std::min(volts.size(), n0 + kChunk);
+        std::int64_t* q = raw.data() + (observed ? n0 : 0);
+        for (std::size_t n = n0; n < n1; ++n) {
+          q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
         }
-        filtered[n] = bp.execute(volts[n]);
+        rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
+        for (std::size_t n = n0; n < n1; ++n) filtered[n] = bp.execute(volts[n]);
       }
+      for (const auto& e : raw_events) ev.push_back(rx.to_float(e));
       if (auto e = rx.flush()) ev.push_back(*e);
       if (observed) (*observer)(design, raw, raw_events);
-      overflows += rx.overflow_events().total() + adc.total();  // adc: input saturations when observed
+      *(ovf ? ovf : &overflows) += rx.overflow_events().total() + adc.total();  // adc: input saturations
+    }
+    return ev;
+  }
+
+  // receive() over a capture read in blocks, events only (the filtered stream is not kept).
+  std::vector<Event> receive_events(CaptureSource& src, double scale, std::size_t block) {
+    std::vector<Event> ev;
+    const double inv = 1.0 / scale;
+    std::vector<double> x(block);
+    src.rewind();
+    if (!fixed()) {
+      ReceiverFloat rf(design);
+      for (std::size_t k; (k = src.read(x)) > 0;) {
+        for (std::size_t i = 0; i < k; ++i) {
+          if (auto e = rf.execute(x[i] * inv)) ev.push_back(*e);
+        }
+      }
+      if (auto e = rf.flush()) ev.push_back(*e);
+    } else {
+      ReceiverFixed rx(design);
+      OverflowCounter adc;
+      std::vector<std::int64_t> raw(block);
+      std::vector<EventFixed> raw_events;
+      for (std::size_t k; (k = src.read(x)) > 0;) {
+        for (std::size_t i = 0; i < k; ++i) {
+          raw[i] = quantize_input(std::clamp(x[i] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
+        }
+        rx.execute_block(std::span<const std::int64_t>(raw.data(), k), raw_events);
+      }
+      for (const auto& e : raw_events) ev.push_back(rx.to_float(e));
+      if (auto e = rx.flush()) ev.push_back(*e);
     }
     return ev;
   }
@@ -343,44 +381,115 @@ struct SceneSimulator::Link {
   // Events -> detections: calibrated arrival, ToF against the schedule, the paper's metrics.
   std::vector<Detection> detections(const std::vector<Event>& ev, const std::vector<double>& filtered, double t0,
                                     const std::vector<Burst>& schedule) {
+    return detections(ev, filtered, t0, schedule, *bank);
+  }
+  // pb: the matched filter to use (PearsonBank is not thread-safe: one per worker thread).
+  std::vector<Detection> detections(const std::vector<Event>& ev, const std::vector<double>& filtered, double t0,
+                                    const std::vector<Burst>& schedule, PearsonBank& pb) {
     std::vector<Detection> out;
-    // T_d of a burst is searched up to the next detected burst's arrival (or the stream's end).
+    for (auto& p : prepare(ev, static_cast<long>(filtered.size()), t0, schedule)) {
+      metrics(p.d, filtered, p.start, p.end, pb);
+      out.push_back(p.d);
+    }
+    return out;
+  }
+
+  // An event as a detection before its metrics: the template start and the end of its T_d search.
+  struct Pending {
+    Detection d;
+    long start = 0, end = 0;
+  };
+  // n: the stream's length. T_d of a burst is searched up to the next detected burst's start (or
+  // the stream's end); ToF against the latest send of the event's code at or before its arrival.
+  std::vector<Pending> prepare(const std::vector<Event>& ev, long n, double t0, const std::vector<Burst>& schedule) {
     std::vector<long> starts;
     for (const auto& e : ev) starts.push_back(std::lround(e.arrival - offset[static_cast<std::size_t>(e.code - 1)]));
+    std::vector<long> sorted = starts;
+    std::sort(sorted.begin(), sorted.end());
+    std::map<int, std::vector<double>> sends;  // per code, sorted
+    for (const auto& b : schedule) sends[b.code].push_back(b.tx_s);
+    for (auto& [code, v] : sends) std::sort(v.begin(), v.end());
+    std::vector<Pending> out;
     for (std::size_t k = 0; k < ev.size(); ++k) {
       const Event& e = ev[k];
-      long end = static_cast<long>(filtered.size());
-      for (long s2 : starts) {
-        if (s2 > starts[k] && s2 < end) end = s2;
+      Pending p;
+      p.start = 0;
+      p.end = n;
+      if (auto it = std::upper_bound(sorted.begin(), sorted.end(), starts[k]); it != sorted.end() && *it < n) {
+        p.end = *it;
       }
-      Detection d;
+      Detection& d = p.d;
       d.code = e.code;
       d.score = e.score;
       d.detector_margin = e.margin;
       const double a = e.arrival - offset[static_cast<std::size_t>(e.code - 1)];
       d.arrival_s = t0 + a / fs();
       double tx = 0;
-      bool found = false;
-      for (const auto& b : schedule) {
-        if (b.code == e.code && b.tx_s <= d.arrival_s && (!found || b.tx_s > tx)) {
-          tx = b.tx_s;
-          found = true;
-        }
+      if (auto sit = sends.find(e.code); sit != sends.end()) {
+        const auto& v = sit->second;
+        if (auto it = std::upper_bound(v.begin(), v.end(), d.arrival_s); it != v.begin()) tx = *(it - 1);
       }
       d.tof_s = d.arrival_s - tx;
-      metrics(d, filtered, std::lround(a), end);
-      out.push_back(d);
+      p.start = std::lround(a);
+      out.push_back(std::move(p));
     }
     return out;
   }
 
   // The paper's metrics of the burst whose template starts at `start`, T_d searched to `end`.
-  void metrics(Detection& d, const std::vector<double>& f, long start, long end) const {
-    const long n = static_cast<long>(f.size());
+  void metrics(Detection& d, const std::vector<double>& f, long start, long end, PearsonBank& pb) const {
+    (void)metrics_window(d, f, 0, static_cast<long>(f.size()), start, end, pb);
+  }
+
+  // The samples of the filtered stream that metrics_window needs for a burst: [lo, hi_min) at
+  // least (hi_min: beyond it only T_d's search may need more, up to the burst's `end`).
+  struct Need {
+    long lo = 0, hi_min = 0;
+  };
+  Need need(long n, long start) const {
+    const long W = static_cast<long>(template_len);
+    const long reach = static_cast<long>(L) * spc;
+    const long lo = std::clamp<long>(start - 3 * spc, 0, n - 1);
+    const long p0 = std::clamp<long>(start, 0, n - 1);
+    const long p1 = std::clamp<long>(start + W, p0 + 1, n);
+    Need r{lo > 2000 ? lo - 2000 : 0, p1};
+    if (start - reach <= n - W && start + reach >= 0 && n >= W) {
+      r.lo = std::min(r.lo, std::max(start - reach, 0L));
+      r.hi_min = std::max(r.hi_min, std::min(start + reach, n - W) + W);
+    }
+    if (start >= 0 && start + W <= n) r.hi_min = std::max(r.hi_min, start + W);
+    return r;
+  }
+
+  // metrics() on a window w = f[base, base + w.size()) of a stream of n samples that holds
+  // need(n, start) (the caller's duty). Returns false, leaving d unset, when T_d's search reached
+  // the window's end before `end` without finding its end: the caller retries with more samples.
+  // Every index is the same as metrics() on the whole stream, so the results are bit for bit.
+  bool metrics_window(Detection& d, std::span<const double> w, long base, long n, long start, long end,
+                      PearsonBank& pb) const {
     const long W = static_cast<long>(template_len);
     const long reach = static_cast<long>(L) * spc;  // the lag window: +-L chips
+    const long avail = base + static_cast<long>(w.size());
+    const long lo = std::clamp<long>(start - 3 * spc, 0, n - 1);
+    const long hi = std::clamp<long>(end, lo + 1, n);
+    const long p0 = std::clamp<long>(start, 0, n - 1);
+    const long p1 = std::clamp<long>(start + W, p0 + 1, n);
+    const long hi_w = std::min(hi, avail);
+    try {
+      const StreamDuration td =
+          duration_td_stream(w, static_cast<std::size_t>(lo - base), static_cast<std::size_t>(hi_w - base),
+                             static_cast<std::size_t>(p0 - base), static_cast<std::size_t>(p1 - base),
+                             static_cast<std::size_t>(2 * spc), fs());
+      if (hi_w < hi && !td.ended_forward) return false;
+      d.td_s = td.seconds;
+      d.td_clipped = td.clipped;
+      d.td_noise_limited = td.noise_limited;
+    } catch (const InputError&) {
+      d.td_s = 0;
+      d.td_clipped = true;
+    }
     if (start - reach <= n - W && start + reach >= 0 && n >= W) {
-      const auto best = bank->search(f, start - reach, start + reach);
+      const auto best = pb.search(w, start - reach - base, start + reach - base);
       d.rho.clear();
       for (const auto& b : best) d.rho.push_back(b.rho);
       const Distinguishability dist = distinguishability(d.rho);
@@ -390,24 +499,9 @@ struct SceneSimulator::Link {
       d.pearson_margin = dist.u;
     }
     if (start >= 0 && start + W <= n) {
-      d.energy = energy(std::span<const double>(f.data() + start, template_len));
+      d.energy = energy(w.subspan(static_cast<std::size_t>(start - base), template_len));
     }
-    const long lo = std::clamp<long>(start - 3 * spc, 0, n - 1);
-    const long hi = std::clamp<long>(end, lo + 1, n);
-    const long p0 = std::clamp<long>(start, 0, n - 1);
-    const long p1 = std::clamp<long>(start + W, p0 + 1, n);
-    try {
-      const StreamDuration td =
-          duration_td_stream(f, static_cast<std::size_t>(lo), static_cast<std::size_t>(hi),
-                             static_cast<std::size_t>(p0), static_cast<std::size_t>(p1),
-                             static_cast<std::size_t>(2 * spc), fs());
-      d.td_s = td.seconds;
-      d.td_clipped = td.clipped;
-      d.td_noise_limited = td.noise_limited;
-    } catch (const InputError&) {
-      d.td_s = 0;
-      d.td_clipped = true;
-    }
+    return true;
   }
 };
 
@@ -486,96 +580,165 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   const double window_samples = lk.L * lk.spc;
   const double match = periodic ? std::min(window_samples, s.excitation.schedule.period_s * s.fs / 2.0) : window_samples;
 
+  // The streams (distance x repeat x train), in output order. The clean bursts are computed
+  // first, in that order, so the workers only read the link's caches.
+  struct Item {
+    std::size_t di = 0, ti = 0;
+    int rep = 0;
+  };
+  std::vector<Item> items;
+  for (std::size_t di = 0; di < s.geometry.distances_m.size(); ++di) {
+    for (const auto& train : trains) {
+      for (const auto& b : train) (void)lk.clean(b.code, s.geometry.distances_m[di]);
+    }
+    for (int rep = 1; rep <= s.geometry.repeats; ++rep) {
+      for (std::size_t ti = 0; ti < trains.size(); ++ti) items.push_back({di, ti, rep});
+    }
+  }
+  // One stream: its measurements, false alarms, overflows and (for the capture callback) its samples.
+  struct StreamOut {
+    std::vector<Measurement> rows;
+    std::size_t fa = 0;
+    std::uint64_t ovf = 0;
+    std::vector<double> x;
+  };
+  const bool keep_x = static_cast<bool>(capture);
+  auto one = [&](const Item& it, PearsonBank& pb) {
+    StreamOut out;
+    const double d = s.geometry.distances_m[it.di];
+    const int rep = it.rep;
+    const auto& train = trains[it.ti];
+    // Assemble the stream.
+    long end = 0;
+    std::vector<long> shifts;
+    for (const auto& b : train) {
+      const Sparse& cb = lk.clean(b.code, d);
+      // Transmission times on the sample grid; the fractional part would need its own
+      // interpolation, so periods are rounded to samples (documented).
+      const long sh = std::lround(b.tx_s * s.fs);
+      shifts.push_back(sh);
+      end = std::max(end, cb.start + sh + static_cast<long>(cb.y.size()));
+    }
+    std::vector<double> x(static_cast<std::size_t>(std::max<long>(end, 0)) + lk.stream_tail(), 0.0);
+    for (std::size_t k = 0; k < train.size(); ++k) Link::add_into(x, lk.clean(train[k].code, d), shifts[k]);
+    if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
+      double sigma = s.noise.noise_v.value_or(0.0);
+      if (s.noise.snr_db) {
+        const Sparse& cb = lk.clean(train.front().code, d);
+        const Duration td = duration_td(cb.y, s.fs);
+        double ms = 0;
+        for (std::size_t n = td.first; n <= td.last; ++n) ms += cb.y[n] * cb.y[n];
+        ms /= static_cast<double>(td.last - td.first + 1);
+        sigma = std::sqrt(ms / std::pow(10.0, *s.noise.snr_db / 10.0));
+      }
+      // The draws depend on the values of the measurement (seed, family, distance, repeat,
+      // the codes and times of its train), never on its place in a list: a measurement gives
+      // the same noise in any scene, sweep, shard or order.
+      StableHash hv;
+      hv.u64(s.noise.seed);
+      hv.str(family);
+      hv.f64(d);
+      hv.u64(static_cast<std::uint64_t>(rep));
+      hv.u64(train.size());
+      for (const auto& b : train) {
+        hv.u64(static_cast<std::uint64_t>(b.code));
+        hv.f64(b.tx_s);
+      }
+      const std::uint64_t seed = splitmix(hv.h);
+      std::mt19937_64 rng(seed);
+      std::normal_distribution<double> nd(0.0, sigma);
+      for (double& v : x) v += nd(rng);
+    }
+    if (s.noise.adc) {
+      const double q = s.noise.adc->full_scale_v / std::ldexp(1.0, s.noise.adc->bits - 1);
+      const double top = std::ldexp(1.0, s.noise.adc->bits - 1);
+      for (double& v : x) v = std::clamp(std::round(v / q), -top, top - 1) * q;
+    }
+    std::vector<double> f;
+    const auto ev = lk.receive(x, lk.input_scale(), f, &out.ovf);
+    const auto dets = lk.detections(ev, f, 0.0, train, pb);
+    std::vector<bool> used(dets.size(), false);
+    for (std::size_t k = 0; k < train.size(); ++k) {
+      Measurement m;
+      m.family = family;
+      m.repeat = rep;
+      m.burst = static_cast<int>(k);
+      m.true_distance_m = d;
+      m.code_sent = train[k].code;
+      const double truth = (train[k].tx_s + d / lk.c()) * s.fs;
+      int best = -1;
+      for (std::size_t i = 0; i < dets.size(); ++i) {
+        if (std::abs(dets[i].arrival_s * s.fs - truth) > match) continue;
+        if (best < 0 || dets[i].score > dets[static_cast<std::size_t>(best)].score) best = static_cast<int>(i);
+      }
+      if (best >= 0) {
+        used[static_cast<std::size_t>(best)] = true;
+        m.detected = true;
+        m.det = dets[static_cast<std::size_t>(best)];
+        m.distance_m = m.det.tof_s * lk.c();
+        m.error_m = m.distance_m - d;
+      } else {
+        // The paper's metrics at the true alignment, T_d searched to the next burst.
+        long end = static_cast<long>(f.size());
+        if (k + 1 < train.size()) end = std::lround((train[k + 1].tx_s + d / lk.c()) * s.fs);
+        lk.metrics(m.det, f, std::lround(truth), end, pb);
+      }
+      m.pearson_error = m.det.rho.empty() || m.det.pearson_code != m.code_sent;
+      m.u = m.det.rho.empty() ? std::nan("") : u_for_sent(m.det.rho, m.code_sent);
+      out.rows.push_back(m);
+    }
+    for (bool u : used) out.fa += !u;
+    if (keep_x) out.x = std::move(x);
+    return out;
+  };
+
   std::vector<Measurement> rows;
   std::size_t fa = 0;
   lk.overflows = 0;
-  for (std::size_t di = 0; di < s.geometry.distances_m.size(); ++di) {
-    const double d = s.geometry.distances_m[di];
-    for (int rep = 1; rep <= s.geometry.repeats; ++rep) {
-      for (std::size_t ti = 0; ti < trains.size(); ++ti) {
-        const auto& train = trains[ti];
-        // Assemble the stream.
-        long end = 0;
-        std::vector<long> shifts;
-        for (const auto& b : train) {
-          const Sparse& cb = lk.clean(b.code, d);
-          // Transmission times on the sample grid; the fractional part would need its own
-          // interpolation, so periods are rounded to samples (documented).
-          const long sh = std::lround(b.tx_s * s.fs);
-          shifts.push_back(sh);
-          end = std::max(end, cb.start + sh + static_cast<long>(cb.y.size()));
-        }
-        std::vector<double> x(static_cast<std::size_t>(std::max<long>(end, 0)) + lk.stream_tail(), 0.0);
-        for (std::size_t k = 0; k < train.size(); ++k) Link::add_into(x, lk.clean(train[k].code, d), shifts[k]);
-        if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
-          double sigma = s.noise.noise_v.value_or(0.0);
-          if (s.noise.snr_db) {
-            const Sparse& cb = lk.clean(train.front().code, d);
-            const Duration td = duration_td(cb.y, s.fs);
-            double ms = 0;
-            for (std::size_t n = td.first; n <= td.last; ++n) ms += cb.y[n] * cb.y[n];
-            ms /= static_cast<double>(td.last - td.first + 1);
-            sigma = std::sqrt(ms / std::pow(10.0, *s.noise.snr_db / 10.0));
+  auto emit = [&](StreamOut& o, const Item& it) {
+    if (capture) {
+      capture({family, s.geometry.distances_m[it.di], it.rep, periodic ? 0 : trains[it.ti].front().code, s.fs, &o.x});
+    }
+    rows.insert(rows.end(), o.rows.begin(), o.rows.end());
+    fa += o.fa;
+    lk.overflows += o.ovf;
+    if (tick) tick();
+  };
+  // The fixed-stream observer sees the streams in order: one thread then.
+  const std::size_t jobs = (observer_ ? 1 : std::min<std::size_t>(static_cast<std::size_t>(std::max(jobs_, 1)), items.size()));
+  if (jobs <= 1) {
+    for (const auto& it : items) {
+      StreamOut o = one(it, *lk.bank);
+      emit(o, it);
+    }
+  } else {
+    // Batches of a few streams per worker; each worker has its own matched filter (PearsonBank
+    // owns FFTW buffers). Results are emitted in item order, so the output does not depend on jobs.
+    std::vector<std::unique_ptr<PearsonBank>> banks;
+    for (std::size_t k = 0; k < jobs; ++k) banks.push_back(std::make_unique<PearsonBank>(lk.templates));
+    const std::size_t batch = 4 * jobs;
+    for (std::size_t b0 = 0; b0 < items.size(); b0 += batch) {
+      const std::size_t b1 = std::min(items.size(), b0 + batch);
+      std::vector<StreamOut> outs(b1 - b0);
+      std::vector<std::exception_ptr> errors(b1 - b0);  // per stream: the first in stream order is thrown
+      std::atomic<std::size_t> next{b0};
+      std::vector<std::thread> pool;
+      for (std::size_t k = 0; k < jobs; ++k) {
+        pool.emplace_back([&, k] {
+          for (std::size_t i = next++; i < b1; i = next++) {
+            try {
+              outs[i - b0] = one(items[i], *banks[k]);
+            } catch (...) {
+              errors[i - b0] = std::current_exception();
+            }
           }
-          // The draws depend on the values of the measurement (seed, family, distance, repeat,
-          // the codes and times of its train), never on its place in a list: a measurement gives
-          // the same noise in any scene, sweep, shard or order.
-          StableHash hv;
-          hv.u64(s.noise.seed);
-          hv.str(family);
-          hv.f64(d);
-          hv.u64(static_cast<std::uint64_t>(rep));
-          hv.u64(train.size());
-          for (const auto& b : train) {
-            hv.u64(static_cast<std::uint64_t>(b.code));
-            hv.f64(b.tx_s);
-          }
-          const std::uint64_t seed = splitmix(hv.h);
-          std::mt19937_64 rng(seed);
-          std::normal_distribution<double> nd(0.0, sigma);
-          for (double& v : x) v += nd(rng);
-        }
-        if (s.noise.adc) {
-          const double q = s.noise.adc->full_scale_v / std::ldexp(1.0, s.noise.adc->bits - 1);
-          const double top = std::ldexp(1.0, s.noise.adc->bits - 1);
-          for (double& v : x) v = std::clamp(std::round(v / q), -top, top - 1) * q;
-        }
-        if (capture) capture({family, d, rep, periodic ? 0 : train.front().code, s.fs, &x});
-        std::vector<double> f;
-        const auto ev = lk.receive(x, lk.input_scale(), f);
-        const auto dets = lk.detections(ev, f, 0.0, train);
-        std::vector<bool> used(dets.size(), false);
-        for (std::size_t k = 0; k < train.size(); ++k) {
-          Measurement m;
-          m.family = family;
-          m.repeat = rep;
-          m.burst = static_cast<int>(k);
-          m.true_distance_m = d;
-          m.code_sent = train[k].code;
-          const double truth = (train[k].tx_s + d / lk.c()) * s.fs;
-          int best = -1;
-          for (std::size_t i = 0; i < dets.size(); ++i) {
-            if (std::abs(dets[i].arrival_s * s.fs - truth) > match) continue;
-            if (best < 0 || dets[i].score > dets[static_cast<std::size_t>(best)].score) best = static_cast<int>(i);
-          }
-          if (best >= 0) {
-            used[static_cast<std::size_t>(best)] = true;
-            m.detected = true;
-            m.det = dets[static_cast<std::size_t>(best)];
-            m.distance_m = m.det.tof_s * lk.c();
-            m.error_m = m.distance_m - d;
-          } else {
-            // The paper's metrics at the true alignment, T_d searched to the next burst.
-            long end = static_cast<long>(f.size());
-            if (k + 1 < train.size()) end = std::lround((train[k + 1].tx_s + d / lk.c()) * s.fs);
-            lk.metrics(m.det, f, std::lround(truth), end);
-          }
-          m.pearson_error = m.det.rho.empty() || m.det.pearson_code != m.code_sent;
-          m.u = m.det.rho.empty() ? std::nan("") : u_for_sent(m.det.rho, m.code_sent);
-          rows.push_back(m);
-        }
-        for (bool u : used) fa += !u;
-        if (tick) tick();
+        });
+      }
+      for (auto& t : pool) t.join();
+      for (std::size_t i = b0; i < b1; ++i) {
+        // As with one thread: the streams before a failing one are emitted, then its error.
+        if (errors[i - b0]) std::rethrow_exception(errors[i - b0]);
+        emit(outs[i - b0], items[i]);
       }
     }
   }
@@ -604,6 +767,71 @@ std::vector<Detection> SceneSimulator::decode(const std::string& family, const s
   const long s0 = std::lround(t0 * scene_.fs);  // sample index of x[0] on the t = 0 grid
   auto dets = lk.detections(ev, f, static_cast<double>(s0) / scene_.fs, schedule);
   return dets;
+}
+
+std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, CaptureSource& src, double period_s,
+                                                     std::size_t block) {
+  Link& lk = link(family);
+  block = std::max<std::size_t>(block, 1);
+  std::vector<double> x(block);
+  // Pass 1: the peak (the receiver sees the capture at half full scale at its peak).
+  double peak = 0;
+  src.rewind();
+  for (std::size_t k; (k = src.read(x)) > 0;) {
+    for (std::size_t i = 0; i < k; ++i) peak = std::max(peak, std::abs(x[i]));
+  }
+  if (peak == 0) return {};
+  const double t0 = src.t0();
+  const long n = static_cast<long>(src.size());
+  std::vector<Burst> schedule;
+  const int eta = lk.design.family.eta();
+  const double span = t0 + static_cast<double>(src.size()) / scene_.fs;
+  if (period_s > 0) {
+    for (long k = 0; k * period_s <= span; ++k) schedule.push_back({static_cast<int>(k % eta) + 1, k * period_s});
+  } else {
+    for (int j = 1; j <= eta; ++j) schedule.push_back({j, 0.0});
+  }
+  const double scale = peak / 0.5;
+  // Pass 2: the receiver's events.
+  const auto ev = lk.receive_events(src, scale, block);
+  const long s0 = std::lround(t0 * scene_.fs);
+  auto pend = lk.prepare(ev, n, static_cast<double>(s0) / scene_.fs, schedule);
+  // Pass 3: the filtered stream (receive()'s, in capture units) through a sliding window that
+  // holds what the bursts whose metrics are pending need (Link::need), oldest first.
+  std::vector<Link::Need> needs;
+  for (const auto& p : pend) needs.push_back(lk.need(n, p.start));
+  std::vector<std::size_t> order(pend.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return needs[a].lo < needs[b].lo; });
+  std::vector<std::size_t> active;
+  std::size_t next = 0;
+  std::vector<double> w;  // f[base, base + w.size())
+  long base = 0;
+  BandpassFloat bp(lk.design.filter);
+  const double inv = 1.0 / scale;
+  const bool fixed = lk.fixed();
+  src.rewind();
+  for (std::size_t k; (k = src.read(x)) > 0;) {
+    for (std::size_t i = 0; i < k; ++i) w.push_back(fixed ? bp.execute(x[i]) : bp.execute(x[i] * inv) * scale);
+    const long avail = base + static_cast<long>(w.size());
+    while (next < order.size() && needs[order[next]].lo < avail) active.push_back(order[next++]);
+    std::erase_if(active, [&](std::size_t i) {
+      return avail >= needs[i].hi_min &&
+             lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, *lk.bank);
+    });
+    long keep = next < order.size() ? std::min(avail, needs[order[next]].lo) : avail;
+    for (std::size_t i : active) keep = std::min(keep, needs[i].lo);
+    if (static_cast<std::size_t>(keep - base) >= block && static_cast<std::size_t>(keep - base) * 2 >= w.size()) {
+      w.erase(w.begin(), w.begin() + (keep - base));
+      base = keep;
+    }
+  }
+  if (!active.empty() || next < order.size() || base + static_cast<long>(w.size()) != n) {
+    throw InputError(src.path() + ": changed while it was read");
+  }
+  std::vector<Detection> out;
+  for (auto& p : pend) out.push_back(std::move(p.d));
+  return out;
 }
 
 std::vector<Detection> SceneSimulator::receive_stream(const std::string& family, const std::vector<double>& x,

@@ -36,6 +36,8 @@
 
 namespace ranging {
 
+class CaptureSource;  // model/sim/capture_stream.hpp
+
 struct SceneStage {
   std::string name;         // transducers, directivity, absorption, delay, gain, noise, adc
   std::string description;  // the parameters it uses
@@ -113,6 +115,12 @@ class SceneSimulator {
   const Scene& scene() const { return scene_; }
   const std::vector<SceneStage>& stages() const { return stages_; }
 
+  // Streams of run() processed in parallel (threads); 1 (the default) runs them in the calling
+  // thread. The result does not depend on it (the noise of a stream is seeded by its values,
+  // results are collected in stream order); a fixed-stream observer forces one thread.
+  void set_jobs(int jobs) { jobs_ = jobs; }
+  int jobs() const { return jobs_; }
+
   // Every measurement of one family (geometry x repeats x bursts). Deterministic for a seed.
   std::vector<Measurement> run(const std::string& family,
                                const std::function<void()>& tick = {},
@@ -126,6 +134,13 @@ class SceneSimulator {
   // period_s, codes 1..eta in order, so tof = arrival - (latest send of that code).
   std::vector<Detection> decode(const std::string& family, const std::vector<double>& x, double t0,
                                 double period_s = 0);
+
+  // decode() of a capture read in blocks of `block` samples (three passes: its peak, the
+  // receiver, the metrics over a sliding window of the filtered stream): the same detections,
+  // bit for bit, in memory independent of the capture's length (the window spans the bursts
+  // whose metrics are pending, about one burst period).
+  std::vector<Detection> decode_stream(const std::string& family, CaptureSource& src, double period_s = 0,
+                                       std::size_t block = std::size_t{1} << 20);
 
   // The receiver of the scene's precision over a stream of volts at the scene's input scale
   // (noise.adc.full_scale_v, else receiver.full_scale_v; decode() instead normalizes to the
@@ -155,6 +170,7 @@ class SceneSimulator {
   std::vector<SceneStage> stages_;
   std::vector<std::unique_ptr<Link>> links_;
   FixedStreamObserver observer_;
+  int jobs_ = 1;
 };
 
 FamilySummary summarize(const Scene& scene, const std::string& family,

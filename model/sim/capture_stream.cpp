@@ -1,0 +1,125 @@
+#include "model/sim/capture_stream.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+#include "model/base/error.hpp"
+#include "model/base/input_file.hpp"
+
+namespace ranging {
+
+namespace {
+constexpr std::size_t kWavBlockBytes = std::size_t{1} << 20;
+}
+
+CaptureSource::CaptureSource(const std::string& path) : path_(path) {
+  std::string ext;
+  if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  if (ext != "csv" && ext != "wav") {
+    throw InputError(path + ": unknown capture type '." + ext + "'; valid: .csv (oscilloscope export), .wav");
+  }
+  csv_ = ext == "csv";
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
+    (void)read_input_file(path, "capture file", 0);  // the missing-file / folder / unreadable message
+    throw InputError(path + ": not a regular file; a capture is read twice (decode streams it)");
+  }
+  in_.open(path, std::ios::binary);
+  if (!in_) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
+  const std::size_t file_size = static_cast<std::size_t>(fs::file_size(path, ec));
+  if (csv_) {
+    CsvCaptureScan scan(path);
+    std::string line;
+    double t = 0, v = 0;
+    while (std::getline(in_, line)) (void)scan.line(line, t, v);
+    if (in_.bad()) throw InputError(path + ": cannot read the capture file");
+    scan.finish();
+    // Second pass: every row on the uniform grid (the rows are known to be well formed now).
+    in_.clear();
+    in_.seekg(0);
+    CsvCaptureScan again(path);
+    std::size_t n = 0;
+    while (std::getline(in_, line)) {
+      if (again.line(line, t, v)) scan.check_grid(n++, t, again.lineno());
+    }
+    rate_ = scan.sample_rate();
+    t0_ = scan.t0();
+    n_ = scan.rows();
+    meta_ = scan.meta();
+    first_data_line_ = scan.first_data_line();
+  } else {
+    wav_ = parse_wav_layout(
+        [&](std::size_t at, std::size_t len) {
+          std::string b(len, '\0');
+          in_.clear();
+          in_.seekg(static_cast<std::streamoff>(at));
+          in_.read(b.data(), static_cast<std::streamsize>(len));
+          b.resize(static_cast<std::size_t>(std::max<std::streamsize>(in_.gcount(), 0)));
+          return b;
+        },
+        file_size, path);
+    rate_ = wav_.rate;
+    n_ = wav_.n;
+    if (wav_.flt || n_ < 2) {  // NaN/Inf are refused before anything is decoded (read_capture's order)
+      rewind();
+      std::vector<double> block(4096);
+      while (read(block) > 0) {
+      }
+    }
+    if (n_ < 2) throw InputError(path + ": byte " + std::to_string(wav_.chunk_at) + ": the data chunk holds fewer than two samples");
+  }
+  merge_capture_sidecar(meta_, path);
+  rewind();
+}
+
+CaptureSource::~CaptureSource() = default;
+
+void CaptureSource::rewind() {
+  in_.clear();
+  pos_ = 0;
+  lineno_ = 0;
+  if (csv_) {
+    in_.seekg(0);
+  } else {
+    in_.seekg(static_cast<std::streamoff>(wav_.body));
+  }
+}
+
+std::size_t CaptureSource::read(std::span<double> out) {
+  std::size_t k = 0;
+  if (csv_) {
+    std::string line;
+    while (k < out.size() && pos_ < n_ && std::getline(in_, line)) {
+      ++lineno_;
+      if (lineno_ < first_data_line_) continue;
+      // The rows were validated at open: the second cell is a finite number.
+      const auto c1 = line.find(',');
+      const char* p = line.c_str() + c1 + 1;
+      while (*p == ' ' || *p == '\t' || *p == '"') ++p;
+      out[k++] = std::strtod(p, nullptr);
+      ++pos_;
+    }
+    if (k < out.size() && pos_ < n_) throw InputError(path_ + ": changed while it was read (fewer rows than at open)");
+    return k;
+  }
+  const std::size_t want = std::min(out.size(), n_ - pos_);
+  while (k < want) {
+    const std::size_t frames = std::min(want - k, std::max<std::size_t>(kWavBlockBytes / wav_.frame, 1));
+    buf_.resize(frames * wav_.frame);
+    in_.read(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+    if (static_cast<std::size_t>(in_.gcount()) != buf_.size()) {
+      throw InputError(path_ + ": changed while it was read (shorter than its data chunk)");
+    }
+    for (std::size_t i = 0; i < frames; ++i) out[k + i] = wav_sample(buf_.data() + i * wav_.frame, wav_, path_, pos_ + i);
+    k += frames;
+    pos_ += frames;
+  }
+  return k;
+}
+
+}  // namespace ranging

@@ -1,0 +1,93 @@
+#pragma once
+// Reading a capture (model/sim/capture.hpp: oscilloscope CSV or WAV) in blocks, for captures
+// longer than memory: CaptureSource validates the whole file when it is opened (the same checks
+// and the same error messages as read_capture, in the same order), then read() delivers the
+// samples in order, a block at a time, as often as rewind() starts over. Memory is one block.
+//   WAV: the header is parsed from the file (parse_wav_layout); the samples are read from the
+//        data chunk in blocks (one pass to check them for NaN/Inf at open for float WAVs).
+//   CSV: open() reads the file once for the header, the rows' syntax and the time grid's span
+//        (CsvCaptureScan), a second time for the uniform-grid check (every row within 2 % of a
+//        step); read() parses the rows again.
+// The pieces read_capture shares with it (one implementation of every check):
+//   CsvCaptureScan  the CSV line grammar, row by row (header lines, metadata keys, strict numbers,
+//                   increasing time), then finish() (Record Length, row count, sample rate) and
+//                   check_grid() per row;
+//   parse_wav_layout / wav_sample  the RIFF chunk walk and one sample's decoding.
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "model/sim/capture.hpp"
+
+namespace ranging {
+
+class CsvCaptureScan {
+ public:
+  explicit CsvCaptureScan(std::string origin);
+  // One line of the file (without its newline): true for a data row (t, v set).
+  bool line(const std::string& text, double& t, double& v);
+  void finish();  // after the last line: the file-level checks; sample_rate() and t0() valid after it
+  void check_grid(std::size_t n, double t, std::size_t line) const;  // row n (0-based) at `line`
+  std::size_t lineno() const { return lineno_; }
+  std::size_t first_data_line() const { return first_data_line_; }
+  std::size_t rows() const { return rows_; }
+  double sample_rate() const { return 1.0 / dt_; }
+  double t0() const { return t_first_; }
+  const CaptureMeta& meta() const { return meta_; }
+
+ private:
+  std::string origin_;
+  CaptureMeta meta_;
+  std::size_t lineno_ = 0, rows_ = 0, first_data_line_ = 0, last_data_line_ = 0, record_line_ = 0;
+  bool data_ = false;
+  double record_length_ = -1, t_first_ = 0, t_last_ = 0, dt_ = 0;
+};
+
+struct WavLayout {
+  std::uint32_t rate = 0;
+  bool flt = false;
+  unsigned bits = 0;
+  std::size_t frame = 0;     // bytes per frame (all channels)
+  std::size_t body = 0;      // byte offset of the first sample
+  std::size_t chunk_at = 0;  // byte offset of the data chunk header
+  std::size_t n = 0;         // frames
+};
+// bytes(at, len): len bytes of the file from offset at (fewer at its end).
+WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::size_t)>& bytes, std::size_t file_size,
+                           const std::string& origin);
+// Frame i at p (its first channel): full-scale fraction (PCM) or the float value; InputError on NaN/Inf.
+double wav_sample(const char* p, const WavLayout& w, const std::string& origin, std::size_t i);
+
+// The sidecar STEM.json of path (if any) fills what meta lacks (read_capture's rule).
+void merge_capture_sidecar(CaptureMeta& meta, const std::string& path);
+
+class CaptureSource {
+ public:
+  explicit CaptureSource(const std::string& path);  // validates the whole file (InputError)
+  ~CaptureSource();
+  double sample_rate() const { return rate_; }
+  double t0() const { return t0_; }
+  std::size_t size() const { return n_; }
+  const CaptureMeta& meta() const { return meta_; }
+  const std::string& path() const { return path_; }
+  void rewind();
+  // Up to out.size() next samples into out; returns how many (0 at the end).
+  std::size_t read(std::span<double> out);
+
+ private:
+  std::string path_;
+  bool csv_ = false;
+  double rate_ = 0, t0_ = 0;
+  std::size_t n_ = 0, pos_ = 0;
+  CaptureMeta meta_;
+  WavLayout wav_;
+  std::size_t first_data_line_ = 0, lineno_ = 0;
+  std::ifstream in_;
+  std::string buf_;
+};
+
+}  // namespace ranging
