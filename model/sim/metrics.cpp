@@ -343,8 +343,33 @@ int eta_required(double max_distance_m, double period_s, double c) {
   require_in_range("speed_of_sound", c, 1e-3, 1e6);
   const double r = max_distance_m / (period_s * c);
   if (r > 1e9) throw InputError("eta_required: L/(T*c) = " + std::to_string(r) + " exceeds 1e9 codes");
-  const double eta = std::ceil(r * (1.0 - 1e-9));
+  const double n = std::round(r);
+  const double eta = std::abs(r - n) <= 1e-9 * std::max(1.0, n) ? n + 1.0 : std::ceil(r);
   return std::max(1, static_cast<int>(eta));
+}
+
+FlatTops flat_top_clipping(std::span<const double> x, std::size_t min_run) {
+  FlatTops t;
+  if (x.empty()) return t;
+  t.high = *std::max_element(x.begin(), x.end());
+  t.low = *std::min_element(x.begin(), x.end());
+  if (t.high == 0.0 && t.low == 0.0) return t;
+  for (const double level : {t.high, t.low}) {
+    std::size_t run = 0;
+    for (std::size_t n = 0; n <= x.size(); ++n) {
+      if (n < x.size() && x[n] == level) {
+        ++run;
+        continue;
+      }
+      if (run >= std::max<std::size_t>(min_run, 1)) {
+        t.samples += run;
+        ++t.runs;
+      }
+      run = 0;
+    }
+    if (t.high == t.low) break;
+  }
+  return t;
 }
 
 double vmax(double td_max_s, int eta, double c, double max_distance_m) {
