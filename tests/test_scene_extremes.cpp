@@ -114,7 +114,9 @@ TEST(SceneExtremes, AtTheUnambiguousRangeEveryAliasIsCounted) {
     if (!m.detected) continue;
     EXPECT_TRUE(m.range_ambiguous || std::abs(m.error_m) < 2e-3) << "burst " << m.burst << " error " << m.error_m;
   }
-  if (r.sum.distance_rmse_with_ambiguous_m > 0.1) EXPECT_GT(r.sum.decode_errors, 0u);
+  if (r.sum.distance_rmse_with_ambiguous_m > 0.1) {
+    EXPECT_GT(r.sum.decode_errors, 0u);
+  }
   // Below the unambiguous range: no warning.
   EXPECT_TRUE(parse_scene("geometry:\n  distances_m: [0.99]\nexcitation:\n  family: Gold4\n"
                           "  schedule:\n    mode: periodic\n    period_s: 0.000326797385620915\n",
