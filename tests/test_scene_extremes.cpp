@@ -183,9 +183,7 @@ TEST(SceneExtremes, TinyAndHugeAmplitudes) {
   EXPECT_EQ(tiny.sum.decode_errors, tiny.sum.measurements);
   const auto huge = run(base + "  drive_vpp: 10000\n" + kAdc);
   EXPECT_EQ(huge.sum.clipped_measurements, huge.sum.measurements);
-  // The float receiver without an ADC is scale-free: the tiny burst decodes.
-  const auto tiny_float = run(base + "  drive_vpp: 0.002\n");
-  EXPECT_EQ(tiny_float.sum.decode_errors, 0u);
+  EXPECT_GT(huge.sum.clipped_max, 100u);
 }
 
 // ADC faults. A DC offset of 0.3 V (the 0.1 V burst stays inside +-1 V): the bandpass removes it,
@@ -226,28 +224,28 @@ TEST(SceneExtremes, TemperatureMinusTwentyToPlusFifty) {
   }
 }
 
-// Sound-velocity compensation: the receiver assumes 343.99 m/s (20 C, 50 %); the air is at T.
+// Sound-velocity compensation: the receiver assumes 343.99 m/s (20 C, 50 %); the air is dry, at T.
 // Independent calculation: c(T) by the ideal-gas law for dry air, c = 331.3 sqrt(1 + T/273.15)
-// (within 0.5 % of Cramer's with humidity at these temperatures), so the uncompensated error at d
-// is d (343.99 / c(T) - 1); with a 0.1 m reference path the error is below 1 mm.
+// (within 0.1 % of Cramer's dry-air value from -20 to +40 C), so the uncompensated error at d is
+// d (343.99 / c(T) - 1); with a 0.1 m reference path the error is below 1 mm.
 TEST(SoundVelocityCompensation, CorrectsTheTemperatureError) {
   for (const double t : {-20.0, 40.0}) {
     const std::string yaml = "transducers: {}\nmedium:\n  temperature_c: " + std::to_string(t) +
-                             "\ngeometry:\n  distances_m: [1.0]\nexcitation:\n  family: Gold4\n  codes: [1, 4]\n"
+                             "\n  relative_humidity: 0\ngeometry:\n  distances_m: [1.0]\nexcitation:\n  family: Gold4\n  codes: [1, 4]\n"
                              "receiver:\n  speed_of_sound: 343.99\n";
     const double c_ideal = 331.3 * std::sqrt(1.0 + t / 273.15);
     const double expect = 1.0 * (343.99 / c_ideal - 1.0);
     const auto raw = run(yaml);
     for (const auto& m : raw.rows) {
       ASSERT_TRUE(m.detected);
-      EXPECT_NEAR(m.error_m, expect, 0.006 * std::abs(expect) + 2e-3) << t << " C";
+      EXPECT_NEAR(m.error_m, expect, 0.02 * std::abs(expect) + 1e-3) << t << " C";
       EXPECT_DOUBLE_EQ(m.speed_used, 343.99);
     }
     const auto comp = run(yaml + "compensation:\n  reference_distance_m: 0.1\n");
     for (const auto& m : comp.rows) {
       ASSERT_TRUE(m.detected);
       EXPECT_LT(std::abs(m.error_m), 1e-3) << t << " C";
-      EXPECT_NEAR(m.speed_used, c_ideal, 0.006 * c_ideal) << t << " C";
+      EXPECT_NEAR(m.speed_used, c_ideal, 0.002 * c_ideal) << t << " C";
       EXPECT_FALSE(m.reference_missed);
     }
     EXPECT_GT(std::abs(expect), 0.03);  // the uncorrected error is centimetres: the test can fail
