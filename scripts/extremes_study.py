@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Scene extremes study (issue 12 section 5) and sound-velocity compensation (issue 14 section 6).
 
 Runs `ranging simulate` (the product; this script only drives it and plots):
@@ -9,7 +9,7 @@ Runs `ranging simulate` (the product; this script only drives it and plots):
         beside an independent prediction d * (c_rx / c(T) - 1) with c(T) from the ideal-gas law
         331.3 sqrt(1 + T/273.15) m/s (dry air).
 
-usage: scripts/extremes_study.py --tool build/tool/ranging --out OUTDIR [snr] [comp]
+usage: /usr/bin/python3 scripts/extremes_study.py --tool build/tool/ranging --out OUTDIR [snr] [comp]
 """
 import argparse
 import csv

@@ -3,8 +3,12 @@
 // the code's own output.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -13,6 +17,7 @@
 #include "model/sim/metrics.hpp"
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
+#include "process.hpp"
 
 using namespace ranging;
 
@@ -268,4 +273,41 @@ TEST(FlatTopClipping, CountsRunsAtTheExtremes) {
   EXPECT_GT(t.samples, 100u);
   EXPECT_EQ(t.runs, 32u);  // 16 cycles, one flat top and one flat bottom each
   EXPECT_EQ(flat_top_clipping(std::vector<double>(10, 0.0)).samples, 0u);
+}
+
+// The tools never clip silently: simulate's text and JSON summaries and decode's output name it,
+// and a range-ambiguous scene warns on stderr and never reads "errors 0".
+TEST(SceneExtremesCli, SimulateAndDecodeReportClipping) {
+  namespace fs = std::filesystem;
+  using ranging::testing_support::run_tool;
+  const fs::path dir = fs::temp_directory_path() / ("ranging_extremes_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  {
+    std::ofstream(dir / "clip.yaml") << "name: clip\ntransducers: {}\ngeometry:\n  distances_m: [0.02]\nexcitation:\n"
+                                        "  family: Gold4\n  codes: [2]\n" << kAdc;
+  }
+  const auto txt = run_tool("simulate " + (dir / "clip.yaml").string() + " --quiet --write-captures --out " + (dir / "t").string());
+  ASSERT_EQ(txt.status, 0) << txt.err;
+  EXPECT_NE(txt.out.find("input clipped (ADC) in 1 of 1 measurements"), std::string::npos) << txt.out;
+  const auto js = run_tool("simulate " + (dir / "clip.yaml").string() + " --json --out " + (dir / "j").string());
+  ASSERT_EQ(js.status, 0) << js.err;
+  const auto j = nlohmann::json::parse(js.out);
+  EXPECT_EQ(j["families"][0]["input_clipping"]["measurements_clipped"], 1);
+  EXPECT_GT(j["families"][0]["input_clipping"]["samples_clipped"].get<int>(), 10);
+  const auto dec = run_tool("decode " + (dir / "t" / "captures" / "Gold4_20mm_r1_j2.csv").string());
+  EXPECT_NE(dec.out.find("input clipped:"), std::string::npos) << dec.out << dec.err;
+
+  {
+    std::ofstream(dir / "amb.yaml") << "name: amb\ntransducers: {}\ngeometry:\n  distances_m: [1.05]\nexcitation:\n"
+                                       "  family: Gold4\n  schedule:\n    mode: periodic\n"
+                                       "    period_s: 0.000326797385620915\n    bursts: 18\n";
+  }
+  const auto amb = run_tool("simulate " + (dir / "amb.yaml").string() + " --json --out " + (dir / "a").string());
+  ASSERT_EQ(amb.status, 0) << amb.err;
+  EXPECT_NE(amb.err.find("unambiguous range"), std::string::npos) << amb.err;
+  const auto a = nlohmann::json::parse(amb.out);
+  EXPECT_EQ(a["families"][0]["range_ambiguous"], 9);
+  EXPECT_GE(a["decode_errors"].get<int>(), 9);
+  fs::remove_all(dir);
 }
