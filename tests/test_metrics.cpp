@@ -106,9 +106,10 @@ TEST(DurationTd, SyntheticBursts) {
 
 TEST(EtaRequired, Equation3) {
   EXPECT_EQ(eta_required(1.0, 0.49e-3, 340.0), 7);  // "greater than six" (section 2.2)
-  // Exactly at an integer ratio no extra code is demanded, despite rounding in T.
-  EXPECT_EQ(eta_required(1.0, 1.0 / (7.0 * 340.0), 340.0), 7);
-  EXPECT_EQ(eta_required(1.0, 1.0 / (9.0 * 340.0), 340.0), 9);
+  // Exactly at an integer ratio d = L aliases to 0 (eta c T = L): one more code is demanded,
+  // whatever the rounding in T.
+  EXPECT_EQ(eta_required(1.0, 1.0 / (7.0 * 340.0), 340.0), 8);
+  EXPECT_EQ(eta_required(1.0, 1.0 / (9.0 * 340.0), 340.0), 10);
   EXPECT_EQ(eta_required(1.0, 0.99 / (9.0 * 340.0), 340.0), 10);
   EXPECT_EQ(eta_required(0.1, 1e-3, 340.0), 1);
   EXPECT_THROW(eta_required(1.0, 0.0, 340.0), InputError);

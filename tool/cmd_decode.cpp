@@ -4,6 +4,7 @@
 // rho_max - rho_submax (eq. 12 as the decoder sees it: the code sent is unknown).
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -226,6 +227,18 @@ int cmd_decode(const Args& args) {
     cal = calibrate_latency(kd, cal_distance, c.value, "option --calibrate (" + cal_path + ")");
   }
 
+  // Input clipping: the capture's flat tops at its extreme values (model/sim/metrics.hpp).
+  // Two streamed passes: the extremes, then the runs at them.
+  FlatTops clip;
+  {
+    FlatTopScan scan;
+    std::vector<double> buf(std::min<std::size_t>(block, std::max<std::size_t>(cap.size(), 1)));
+    cap.rewind();
+    for (std::size_t k; (k = cap.read(buf)) > 0;) scan.levels(std::span<const double>(buf.data(), k));
+    cap.rewind();
+    for (std::size_t k; (k = cap.read(buf)) > 0;) scan.runs(std::span<const double>(buf.data(), k));
+    clip = scan.result();
+  }
   std::vector<Detection> dets, below;
   for (auto d : sim.decode_stream(family, cap, period.value, block)) {
     if (cal) d.tof_s = cal->correct(d.code, d.tof_s);
@@ -270,6 +283,8 @@ int cmd_decode(const Args& args) {
     j["below_gate"] = nlohmann::json::array();
     for (const auto& d : below) j["below_gate"].push_back(det_json(d));
     j["found"] = !dets.empty();
+    j["input_clipping"] = {{"samples", clip.samples}, {"runs", clip.runs}, {"max", clip.high}, {"min", clip.low},
+                           {"rule", "runs of >= 3 consecutive samples at the capture's maximum or minimum"}};
     std::cout << stamp_build_info(j).dump(2) << "\n";
   } else {
     std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s\n",
@@ -288,6 +303,13 @@ int cmd_decode(const Args& args) {
     }
     if (dets.empty()) {
       std::printf(below.empty() ? "no burst detected\n" : "no burst passed the gate\n");
+    }
+    if (clip.samples > 0) {
+      std::printf("input clipped: %zu samples in %zu flat tops at the capture's extremes (%.6g / %.6g): distances and rho "
+                  "may be biased\n",
+                  clip.samples, clip.runs, clip.high, clip.low);
+    } else {
+      std::printf("input clipping: none (no run of >= 3 samples at the capture's extremes)\n");
     }
   }
   return dets.empty() ? 1 : 0;

@@ -150,7 +150,7 @@ std::string measurements_csv(const SceneRun& run, double /*c*/) {
   std::ostringstream os;
   os << "family,repeat,burst,true_distance_m,code_sent,code_decoded,tof_s,distance_m,error_m,"
         "rho_max,rho_submax,u,energy_v2,td_s,pearson_code,receiver_rho2,receiver_rho2_margin,pearson_margin,"
-        "td_clipped,td_noise_limited\n";
+        "td_clipped,td_noise_limited,adc_clipped,range_ambiguous,speed_used,reference_missed\n";
   for (const auto& r : run.rows) {
     os << r.family << "," << r.repeat << "," << r.burst << "," << num(r.true_distance_m) << "," << r.code_sent
        << "," << (r.detected ? r.det.code : 0) << "," << (r.detected ? num(r.det.tof_s, 12) : "") << ","
@@ -158,7 +158,9 @@ std::string measurements_csv(const SceneRun& run, double /*c*/) {
        << num(r.det.rho_max, 6) << "," << num(r.det.rho_submax, 6) << "," << num(r.u, 6) << ","
        << num(r.det.energy, 6) << "," << num(r.det.td_s, 6) << "," << r.det.pearson_code << ","
        << (r.detected ? num(r.det.score, 6) : "") << "," << (r.detected ? num(r.det.detector_margin, 6) : "") << ","
-       << num(r.det.pearson_margin, 6) << "," << r.det.td_clipped << "," << r.det.td_noise_limited << "\n";
+       << num(r.det.pearson_margin, 6) << "," << r.det.td_clipped << "," << r.det.td_noise_limited << ","
+       << r.adc_clipped << "," << r.range_ambiguous << "," << num(r.speed_used, 9) << "," << r.reference_missed
+       << "\n";
   }
   return os.str();
 }
@@ -171,6 +173,11 @@ nlohmann::json summary_json(const SceneSimulator& sim, const SceneRun& run) {
   j["file"] = s.origin;
   j["precision"] = s.receiver.precision;
   j["speed_of_sound"] = s.speed();
+  j["receiver_speed_of_sound"] = s.receiver_speed();
+  j["compensation"] = s.compensation ? nlohmann::json{{"reference_distance_m", s.compensation->reference_distance_m},
+                                                      {"equation", "c_est = d_ref / tof_ref; d = c_est * tof"}}
+                                     : nlohmann::json(nullptr);
+  j["warnings"] = s.warnings;
   j["max_range_m"] = s.range_l();
   j["stages"] = nlohmann::json::array();
   for (const auto& st : sim.stages()) j["stages"].push_back({{"name", st.name}, {"description", st.description}});
@@ -199,6 +206,14 @@ nlohmann::json summary_json(const SceneSimulator& sim, const SceneRun& run) {
                                           {"decode_errors", f.pearson_errors}, {"u_min", jnum(f.u_min)},
                                           {"u_max_over_min", jnum(f.u_max_over_min)}}},
                              {"td_clipped", f.td_clipped}, {"td_noise_limited", f.td_noise_limited},
+                             {"input_clipping", {{"stage", s.noise.adc ? "adc" : "receiver input clamp"},
+                                                 {"measurements_clipped", f.clipped_measurements},
+                                                 {"samples_clipped", f.clipped_samples},
+                                                 {"max_samples_per_measurement", f.clipped_max}}},
+                             {"range_ambiguous", f.range_ambiguous},
+                             {"unambiguous_range_m", f.unambiguous_range_m > 0 ? jnum(f.unambiguous_range_m) : nlohmann::json(nullptr)},
+                             {"distance_rmse_with_ambiguous_m", jnum(f.distance_rmse_with_ambiguous_m)},
+                             {"compensation_reference_missed", f.reference_missed},
                              {"per_code", per}});
   }
   j["decode_errors"] = err;
@@ -235,7 +250,7 @@ int cmd_simulate(const Args& args) {
   add_scene_options(p);
   if (!p.parse(args)) return 0;
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
-  Scene scene = load_scene_options(p, "simulate");
+  Scene scene = load_scene_options(p, "simulate");  // prints the scene's warnings
   if (p.has("--precision")) {
     const std::string prec = *p.get("--precision");
     if (prec != "float" && prec != "fixed" && prec != "rtl") {
@@ -327,6 +342,30 @@ int cmd_simulate(const Args& args) {
             "rho^2 detector and its smallest per-code mean margin; prs.err / u_min: the paper's Pearson\n"
             "matched filter (+-L chips) and eq. 10's u; Td_clip / Td_noise: T_d measurements the search\n"
             "range clipped / whose threshold the noise floor set (docs/signal-model.md)\n";
+    for (const auto& f : run.summaries) {
+      if (f.clipped_measurements > 0) {
+        text << "warning: " << f.family << ": input clipped (" << (scene.noise.adc ? "ADC" : "receiver input clamp")
+             << ") in " << f.clipped_measurements << " of " << f.measurements << " measurements, "
+             << f.clipped_samples << " samples, up to " << f.clipped_max << " per measurement\n";
+      } else {
+        text << f.family << ": input clipping: none\n";
+      }
+      if (f.range_ambiguous > 0) {
+        char b[256];
+        std::snprintf(b, sizeof b, "%.1f mm with them", f.distance_rmse_with_ambiguous_m * 1e3);
+        text << "warning: " << f.family << ": " << f.range_ambiguous << " range-ambiguous measurements (distance >= "
+             << "eta*c*T = " << f.unambiguous_range_m << " m aliased), counted as errors and left out of rmse ("
+             << b << ")\n";
+      }
+      if (f.reference_missed > 0) {
+        text << "warning: " << f.family << ": compensation reference burst missed in " << f.reference_missed
+             << " measurements (the receiver's c " << scene.receiver_speed() << " m/s used)\n";
+      }
+    }
+    if (scene.compensation) {
+      text << "sound-velocity compensation: reference path " << scene.compensation->reference_distance_m
+           << " m, c_est = d_ref / tof_ref, d = c_est * tof\n";
+    }
     if (rtl) {
       const auto& r = summary["rtl"];
       text << "\nRTL (Verilated receiver_top): " << r["streams"] << " streams, " << r["events_compared"]

@@ -18,6 +18,7 @@
 #include "model/base/error.hpp"
 #include "model/config/receiver_config.hpp"
 #include "model/dsp/bandpass_filter.hpp"
+#include "model/dsp/limit_cycle_search.hpp"
 #include "model/dsp/stability.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
@@ -181,6 +182,26 @@ int cmd_stability(const Args& args) {
   }
   j["overflow_oscillations"] = osc;
 
+  // Exhaustive search: every initial state of each quantized section's zero-input recursion, at
+  // small data widths (model/dsp/limit_cycle_search.hpp), each rounding and overflow mode.
+  json exh = json::array();
+  const QuantizedSos qs = quantize_sos(filter, bc.coef_bits, bc.coef_frac, "bandpass_fixed");
+  for (std::size_t k = 0; k < qs.sections.size(); ++k) {
+    for (int w : {6, 8}) {
+      for (Rounding r : kRoundings) {
+        for (Overflow o : kOverflows) {
+          const LimitCycleSearch ls =
+              exhaustive_limit_cycles(qs.sections[k][3], qs.sections[k][4], qs.frac, FixedFormat{w, 0, true, r, o});
+          exh.push_back({{"section", k + 1}, {"data_bits", w}, {"rounding", rounding_str(r)}, {"overflow", overflow_str(o)},
+                         {"states", ls.states}, {"nonzero_cycles", ls.nonzero_cycles},
+                         {"states_into_nonzero", ls.states_into_nonzero}, {"max_amplitude_lsb", ls.max_amplitude_lsb},
+                         {"period", ls.period_of_max}, {"full_scale_lsb", (1 << (w - 1))}});
+        }
+      }
+    }
+  }
+  j["exhaustive_limit_cycles"] = exh;
+
   if (!p.has("--quick")) {
     // Amplitude (worst over the excitations) against the data width (coefficients as
     // configured) and against the coefficient width (data as configured), saturating.
@@ -275,6 +296,19 @@ int cmd_stability(const Args& args) {
     std::snprintf(buf, sizeof buf, "  section %d  %-9s %8.0f LSB  period %5d\n", o["section"].get<int>(),
                   o["overflow"].get<std::string>().c_str(), o["amplitude_lsb"].get<double>(), o["period"].get<int>());
     os << buf;
+  }
+  os << "\nexhaustive zero-input search, every initial state of each section (coefficients as\n"
+        "configured, data words of 6 and 8 bits; largest cycle in LSB / its period):\n"
+        "  section bits  truncate/wrap  truncate/sat  half-up/wrap  half-up/sat  convergent/wrap  convergent/sat\n";
+  for (std::size_t i = 0; i + 5 < exh.size(); i += 6) {
+    std::snprintf(buf, sizeof buf, "  %7d %4d", exh[i]["section"].get<int>(), exh[i]["data_bits"].get<int>());
+    os << buf;
+    for (std::size_t m = 0; m < 6; ++m) {
+      std::snprintf(buf, sizeof buf, " %9lld/%-5d", static_cast<long long>(exh[i + m]["max_amplitude_lsb"].get<std::int64_t>()),
+                    exh[i + m]["period"].get<int>());
+      os << buf;
+    }
+    os << "\n";
   }
   if (j.contains("structures")) {
     os << "\nlimit-cycle amplitude (LSB, worst excitation) vs data bits, saturating:\n  bits ";

@@ -1,5 +1,7 @@
 #include "tool/options.hpp"
 
+#include <cstdio>
+
 #include "tool/guard.hpp"
 
 namespace ranging::tool {
@@ -16,6 +18,7 @@ Scene load_scene_options(const cli::Parser& p, const std::string& cmd, Overrides
   const Overrides ov = parse_overrides(p.values("--set"));
   Scene scene = load_scene(p.positionals().at(0), ov, p.has("--allow-out-of-spec"));
   warn_if_out_of_spec(cmd, scene.receiver.config);
+  for (const auto& w : scene.warnings) std::fprintf(stderr, "ranging %s: warning: %s\n", cmd.c_str(), w.c_str());
   if (overrides) *overrides = ov;
   return scene;
 }

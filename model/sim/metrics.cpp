@@ -356,8 +356,55 @@ int eta_required(double max_distance_m, double period_s, double c) {
   require_in_range("speed_of_sound", c, 1e-3, 1e6);
   const double r = max_distance_m / (period_s * c);
   if (r > 1e9) throw InputError("eta_required: L/(T*c) = " + std::to_string(r) + " exceeds 1e9 codes");
-  const double eta = std::ceil(r * (1.0 - 1e-9));
+  const double n = std::round(r);
+  const double eta = std::abs(r - n) <= 1e-9 * std::max(1.0, n) ? n + 1.0 : std::ceil(r);
   return std::max(1, static_cast<int>(eta));
+}
+
+void FlatTopScan::levels(std::span<const double> x) {
+  if (x.empty()) return;
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  t_.high = any_ ? std::max(t_.high, *hi) : *hi;
+  t_.low = any_ ? std::min(t_.low, *lo) : *lo;
+  any_ = true;
+}
+
+void FlatTopScan::runs(std::span<const double> x) {
+  if (!any_ || (t_.high == 0.0 && t_.low == 0.0)) return;
+  auto step = [&](std::size_t& run, bool at_level) {
+    if (at_level) {
+      ++run;
+      return;
+    }
+    if (run >= min_run_) {
+      t_.samples += run;
+      ++t_.runs;
+    }
+    run = 0;
+  };
+  for (const double v : x) {
+    step(run_high_, v == t_.high);
+    if (t_.high != t_.low) step(run_low_, v == t_.low);
+  }
+}
+
+FlatTops FlatTopScan::result() const {
+  FlatTops t = t_;
+  if (!any_ || (t.high == 0.0 && t.low == 0.0)) return any_ ? FlatTops{0, 0, t.high, t.low} : FlatTops{};
+  for (const std::size_t run : {run_high_, run_low_}) {  // runs that reach the end of the stream
+    if (run >= min_run_) {
+      t.samples += run;
+      ++t.runs;
+    }
+  }
+  return t;
+}
+
+FlatTops flat_top_clipping(std::span<const double> x, std::size_t min_run) {
+  FlatTopScan scan(min_run);
+  scan.levels(x);
+  scan.runs(x);
+  return scan.result();
 }
 
 double vmax(double td_max_s, int eta, double c, double max_distance_m) {

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <map>
 #include <memory>
+#include <algorithm>
 #include <span>
 #include <vector>
 
@@ -117,8 +118,38 @@ StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std
 // < 2; NaN if either sample is constant (no ranking).
 double spearman(std::span<const double> a, std::span<const double> b);
 
-// Eq. 3: eta >= L/(T*c), the smallest integer number of codes. Ratios within 1e-9
-// (relative) of an integer count as that integer, so rounding never demands an extra code.
+// Clipping seen in a recorded stream (decode: a capture carries no ADC flags): the samples that
+// lie in runs of at least min_run consecutive samples equal to the stream's maximum or to its
+// minimum (flat tops). An unclipped 200 kHz burst sampled at >= 1 MS/s repeats its extreme
+// value on consecutive samples only if its amplitude is a few LSB; a clipped one holds it.
+// 0 for an all-zero stream.
+struct FlatTops {
+  std::size_t samples = 0;   // samples in such runs
+  std::size_t runs = 0;
+  double high = 0, low = 0;  // the stream's maximum and minimum
+};
+FlatTops flat_top_clipping(std::span<const double> x, std::size_t min_run = 3);
+
+// The same count over a stream read in blocks (decode streams its capture): pass 1 feeds every
+// block to levels(), pass 2 feeds them again to runs(); result() then equals
+// flat_top_clipping() of the whole stream.
+class FlatTopScan {
+ public:
+  explicit FlatTopScan(std::size_t min_run = 3) : min_run_(std::max<std::size_t>(min_run, 1)) {}
+  void levels(std::span<const double> x);
+  void runs(std::span<const double> x);
+  FlatTops result() const;
+
+ private:
+  std::size_t min_run_;
+  bool any_ = false;
+  FlatTops t_;
+  std::size_t run_high_ = 0, run_low_ = 0;
+};
+
+// Eq. 3: eta * c * T > L, the smallest integer number of codes for which a burst from distance
+// L arrives before the next send of its own code (at equality d = L aliases to 0). Ratios
+// L/(T*c) within 1e-9 (relative) of an integer n count as n, and demand n + 1.
 int eta_required(double max_distance_m, double period_s, double c);
 
 // Eq. 4: v_max = min(1/(1.5*T_d), eta*c/L) in Hz.

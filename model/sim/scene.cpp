@@ -25,6 +25,13 @@ double Scene::speed() const {
   return 340.0;  // the paper's value
 }
 
+double Scene::receiver_speed() const { return receiver.speed_of_sound.value_or(speed()); }
+
+double Scene::unambiguous_range_m(int eta) const {
+  if (excitation.schedule.mode != "periodic") return 0.0;
+  return eta * speed() * excitation.schedule.period_s;
+}
+
 double Scene::range_l() const {
   if (max_range_m > 0) return max_range_m;
   double l = 0;
@@ -179,6 +186,9 @@ Scene parse_document(YAML::Node root, const std::string& origin, const std::stri
       a.get_range("bits", adc.bits, 2, 24);
       a.get_range("full_scale_v", adc.full_scale_v, 1e-6, 1e4);
       a.get_range("sample_rate", s.fs, 1e4, 1e9);
+      a.get_range("dc_offset_v", adc.dc_offset_v, -1e4, 1e4);
+      a.get_range("stuck_bit", adc.stuck_bit, -1, adc.bits - 1);
+      a.get_range("stuck_value", adc.stuck_value, 0, 1);
       n.adc = adc;
     });
   });
@@ -225,6 +235,13 @@ Scene parse_document(YAML::Node root, const std::string& origin, const std::stri
     if (rc.reference == "files" && rc.references_dir.empty()) r.error("reference", "'files' needs references_dir");
     r.get_range("full_scale_v", rc.full_scale_v, 1e-6, 1e4);
     r.get_range("calibration_distance_m", rc.calibration_distance_m, 0.01, 20);
+    double c = 0;
+    if (r.get_range("speed_of_sound", c, 100, 10000)) rc.speed_of_sound = c;
+  });
+  section(top, "compensation", [&](Reader& r) {
+    SceneCompensation comp;
+    r.get_range("reference_distance_m", comp.reference_distance_m, 0.01, 20);
+    s.compensation = comp;
   });
   top.finish();
   if (s.geometry.type == "rotor") check_rotor_scene(s);  // model/sim/rotor.cpp
@@ -250,6 +267,22 @@ Scene parse_document(YAML::Node root, const std::string& origin, const std::stri
     validate(ex);
   } catch (const InputError& e) {
     throw InputError(yaml::locate(root, origin, e.what()));
+  }
+
+  if (s.excitation.schedule.mode == "periodic") {
+    double dmax = 0;
+    for (double d : s.geometry.distances_m) dmax = std::max(dmax, d);
+    for (const auto& name : s.excitation.families) {
+      const int eta = code_family(name).eta();
+      const double ru = s.unambiguous_range_m(eta);
+      if (dmax >= ru * (1.0 - 1e-9)) {
+        std::ostringstream os;
+        os << origin << ": geometry.distances_m: the largest distance " << dmax << " m reaches the unambiguous range "
+           << "eta*c*T = " << eta << " * " << s.speed() << " m/s * " << s.excitation.schedule.period_s << " s = " << ru
+           << " m of " << name << " (eq. 3): measurements at or beyond it alias and count as range-ambiguous errors";
+        s.warnings.push_back(os.str());
+      }
+    }
   }
 
   // The effective scene document: paths made absolute (the configuration goes beside it).

@@ -63,9 +63,17 @@ struct SceneExcitation {
   double amplitude() const { return drive_vpp / 2.0 * amplifier_gain; }
 };
 
+// The ADC: code = clamp(round((v + dc_offset_v) / q), -2^(bits-1), 2^(bits-1) - 1),
+// q = full_scale_v / 2^(bits-1); the output is code * q volts. Samples whose rounded code lay
+// outside the range are clipped and counted (Measurement::adc_clipped). A stuck bit (a fault):
+// bit stuck_bit (0 = LSB .. bits-1 = sign) of the two's-complement code is forced to
+// stuck_value after clipping.
 struct SceneAdc {
   int bits = 12;
   double full_scale_v = 1.0;   // +-full_scale_v maps to the code range; beyond clips
+  double dc_offset_v = 0.0;    // fault: DC offset added at the ADC input
+  int stuck_bit = -1;          // fault: -1 none, else the stuck bit's index
+  int stuck_value = 0;         // 0 or 1
 };
 
 struct SceneNoise {
@@ -83,6 +91,19 @@ struct SceneReceiver {
   std::string references_dir;       // reference = files
   double full_scale_v = 1.0;        // receiver input scale without an ADC stage
   double calibration_distance_m = 0.1;
+  // The c the receiver converts ToF to distance with (receiver.speed_of_sound); unset: the
+  // channel's c (Scene::speed()). With compensation it is replaced by each measurement's c_est.
+  std::optional<double> speed_of_sound;
+};
+
+// Sound-velocity compensation (paper section 3.1, issue 14 section 6): with every measurement
+// the system also sends a burst (the same code) over a reference path of calibrated length
+// d_ref through the same channel (same c, noise and ADC, its own noise draw), and measures its
+// one-way time of flight tof_ref with the same receiver. Then
+//   c_est = d_ref / tof_ref,   d = c_est * tof.
+// The RTL's tof_distance speed register takes the same c_est (the loop helper wires it).
+struct SceneCompensation {
+  double reference_distance_m = 0.1;
 };
 
 struct Scene {
@@ -96,14 +117,22 @@ struct Scene {
   SceneExcitation excitation;
   SceneNoise noise;
   SceneReceiver receiver;
+  std::optional<SceneCompensation> compensation;  // compensation: {reference_distance_m: D}
   double max_range_m = 0;           // L of eq. 3/4 (0: the largest distance)
   // The effective documents (after --set overrides), written next to every output so a run can
   // be repeated: the scene refers to its receiver configuration as "config.yaml" beside it.
   YAML::Node effective_document;       // the scene document, paths made absolute
   std::string effective_config_yaml;   // empty: the scene uses the built-in configuration
 
-  double speed() const;             // c used by the channel and by the receiver's ToF -> d
+  double speed() const;             // c of the channel (and the receiver's calibration)
+  double receiver_speed() const;    // c the receiver assumes: receiver.speed_of_sound, else speed()
   double range_l() const;
+  // Periodic schedule: eta * c * T, the largest distance that does not alias (eq. 3); 0 in
+  // single mode (every burst alone in its stream: no ambiguity).
+  double unambiguous_range_m(int eta) const;
+  // Warnings found at load (the tools print them on stderr): a periodic scene whose largest
+  // distance reaches the unambiguous range eta * c * T of a family.
+  std::vector<std::string> warnings;
 };
 
 // overrides (--set KEY=VALUE, model/config/overrides.hpp) apply to the scene document before it

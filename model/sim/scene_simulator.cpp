@@ -218,8 +218,9 @@ struct SceneSimulator::Link {
   // float bandpass output in volts. The fixed receiver's saturations/wraps (input included) are
   // added to *ovf (default: this link's counter). The fixed receiver runs through its block API
   // (ReceiverFixed::execute_block, bit-exact with execute_raw per sample: tests/test_block_api).
+  // clamped (fixed precision): appends the indices of the samples the input clamp to +-scale cut.
   std::vector<Event> receive(const std::vector<double>& volts, double scale, std::vector<double>& filtered,
-                             std::uint64_t* ovf = nullptr) {
+                             std::uint64_t* ovf = nullptr, std::vector<std::size_t>* clamped = nullptr) {
     std::vector<Event> ev;
     filtered.resize(volts.size());
     const double inv = 1.0 / scale;
@@ -244,6 +245,7 @@ struct SceneSimulator::Link {
         const std::size_t n1 = std::min(volts.size(), n0 + kChunk);
         std::int64_t* q = raw.data() + (observed ? n0 : 0);
         for (std::size_t n = n0; n < n1; ++n) {
+          if (clamped && std::abs(volts[n] * inv) > 1.0) clamped->push_back(n);
           q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
         }
         rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
@@ -590,11 +592,72 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   for (std::size_t di = 0; di < s.geometry.distances_m.size(); ++di) {
     for (const auto& train : trains) {
       for (const auto& b : train) (void)lk.clean(b.code, s.geometry.distances_m[di]);
+      if (s.compensation) (void)lk.clean(train.front().code, s.compensation->reference_distance_m);
     }
     for (int rep = 1; rep <= s.geometry.repeats; ++rep) {
       for (std::size_t ti = 0; ti < trains.size(); ++ti) items.push_back({di, ti, rep});
     }
   }
+  // The noise stage's sigma for a measurement at d: snr_db is against the mean square of the
+  // noise-free burst (the train's first code at d) over its T_d; the compensation reference
+  // shares the measurement's sigma (the same electronics).
+  auto noise_sigma = [&](const std::vector<Burst>& train, double d) {
+    double sigma = s.noise.noise_v.value_or(0.0);
+    if (s.noise.snr_db) {
+      const Sparse& cb = lk.clean(train.front().code, d);
+      const Duration td = duration_td(cb.y, s.fs);
+      double ms = 0;
+      for (std::size_t n = td.first; n <= td.last; ++n) ms += cb.y[n] * cb.y[n];
+      ms /= static_cast<double>(td.last - td.first + 1);
+      sigma = std::sqrt(ms / std::pow(10.0, *s.noise.snr_db / 10.0));
+    }
+    return sigma;
+  };
+  // Noise then ADC over a stream assembled for (d, rep, train); salt 0: the measurement's own
+  // stream, 1: its compensation reference. Appends the indices of the samples the ADC clipped.
+  auto add_noise_and_adc = [&](std::vector<double>& x, double sigma, double d, int rep,
+                               const std::vector<Burst>& train, std::uint64_t salt,
+                               std::vector<std::size_t>& clipped) {
+    if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
+      // The draws depend on the values of the measurement (seed, family, distance, repeat,
+      // the codes and times of its train), never on its place in a list: a measurement gives
+      // the same noise in any scene, sweep, shard or order.
+      StableHash hv;
+      hv.u64(s.noise.seed);
+      hv.str(family);
+      hv.f64(d);
+      hv.u64(static_cast<std::uint64_t>(rep));
+      hv.u64(train.size());
+      for (const auto& b : train) {
+        hv.u64(static_cast<std::uint64_t>(b.code));
+        hv.f64(b.tx_s);
+      }
+      if (salt != 0) hv.u64(salt);
+      const std::uint64_t seed = splitmix(hv.h);
+      std::mt19937_64 rng(seed);
+      std::normal_distribution<double> nd(0.0, sigma);
+      for (double& v : x) v += nd(rng);
+    }
+    if (s.noise.adc) {
+      const SceneAdc& a = *s.noise.adc;
+      const double q = a.full_scale_v / std::ldexp(1.0, a.bits - 1);
+      const double top = std::ldexp(1.0, a.bits - 1);
+      const auto mask = (std::uint64_t{1} << a.bits) - 1;
+      for (std::size_t n = 0; n < x.size(); ++n) {
+        const double r = std::round((x[n] + a.dc_offset_v) / q);
+        if (r < -top || r > top - 1) clipped.push_back(n);
+        auto code = static_cast<std::int64_t>(std::clamp(r, -top, top - 1));
+        if (a.stuck_bit >= 0) {  // two's complement of `bits` bits, the bit forced, sign-extended back
+          std::uint64_t u = static_cast<std::uint64_t>(code) & mask;
+          const std::uint64_t bit = std::uint64_t{1} << a.stuck_bit;
+          u = a.stuck_value ? (u | bit) : (u & ~bit);
+          code = (u & (std::uint64_t{1} << (a.bits - 1))) ? static_cast<std::int64_t>(u) - static_cast<std::int64_t>(mask) - 1
+                                                         : static_cast<std::int64_t>(u);
+        }
+        x[n] = static_cast<double>(code) * q;
+      }
+    }
+  };
   // One stream: its measurements, false alarms, overflows and (for the capture callback) its samples.
   struct StreamOut {
     std::vector<Measurement> rows;
@@ -621,42 +684,47 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     }
     std::vector<double> x(static_cast<std::size_t>(std::max<long>(end, 0)) + lk.stream_tail(), 0.0);
     for (std::size_t k = 0; k < train.size(); ++k) Link::add_into(x, lk.clean(train[k].code, d), shifts[k]);
-    if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
-      double sigma = s.noise.noise_v.value_or(0.0);
-      if (s.noise.snr_db) {
-        const Sparse& cb = lk.clean(train.front().code, d);
-        const Duration td = duration_td(cb.y, s.fs);
-        double ms = 0;
-        for (std::size_t n = td.first; n <= td.last; ++n) ms += cb.y[n] * cb.y[n];
-        ms /= static_cast<double>(td.last - td.first + 1);
-        sigma = std::sqrt(ms / std::pow(10.0, *s.noise.snr_db / 10.0));
-      }
-      // The draws depend on the values of the measurement (seed, family, distance, repeat,
-      // the codes and times of its train), never on its place in a list: a measurement gives
-      // the same noise in any scene, sweep, shard or order.
-      StableHash hv;
-      hv.u64(s.noise.seed);
-      hv.str(family);
-      hv.f64(d);
-      hv.u64(static_cast<std::uint64_t>(rep));
-      hv.u64(train.size());
-      for (const auto& b : train) {
-        hv.u64(static_cast<std::uint64_t>(b.code));
-        hv.f64(b.tx_s);
-      }
-      const std::uint64_t seed = splitmix(hv.h);
-      std::mt19937_64 rng(seed);
-      std::normal_distribution<double> nd(0.0, sigma);
-      for (double& v : x) v += nd(rng);
-    }
-    if (s.noise.adc) {
-      const double q = s.noise.adc->full_scale_v / std::ldexp(1.0, s.noise.adc->bits - 1);
-      const double top = std::ldexp(1.0, s.noise.adc->bits - 1);
-      for (double& v : x) v = std::clamp(std::round(v / q), -top, top - 1) * q;
-    }
+    std::vector<std::size_t> clipped;  // sample indices the input stage clipped
+    const double sigma = noise_sigma(train, d);
+    add_noise_and_adc(x, sigma, d, rep, train, 0, clipped);
     std::vector<double> f;
-    const auto ev = lk.receive(x, lk.input_scale(), f, &out.ovf);
+    const auto ev = lk.receive(x, lk.input_scale(), f, &out.ovf, s.noise.adc ? nullptr : &clipped);
     const auto dets = lk.detections(ev, f, 0.0, train, pb);
+    // Compensation: the reference path measures c (SceneCompensation).
+    double c_est = s.receiver_speed();
+    bool ref_missed = false;
+    if (s.compensation) {
+      const double dref = s.compensation->reference_distance_m;
+      const Burst rb{train.front().code, 0.0};
+      const Sparse& cb = lk.clean(rb.code, dref);
+      std::vector<double> xr(static_cast<std::size_t>(std::max<long>(cb.start + static_cast<long>(cb.y.size()), 0)) +
+                                 lk.stream_tail(),
+                             0.0);
+      Link::add_into(xr, cb, 0);
+      std::vector<std::size_t> rclip;
+      add_noise_and_adc(xr, sigma, d, rep, train, 1, rclip);
+      std::vector<double> fr;
+      const auto rev = lk.receive(xr, lk.input_scale(), fr, &out.ovf);
+      const auto rdets = lk.detections(rev, fr, 0.0, {rb}, pb);
+      const double rtruth = dref / lk.c() * s.fs;
+      int rbest = -1;
+      for (std::size_t i = 0; i < rdets.size(); ++i) {
+        if (rdets[i].code != rb.code || std::abs(rdets[i].arrival_s * s.fs - rtruth) > window_samples) continue;
+        if (rbest < 0 || rdets[i].score > rdets[static_cast<std::size_t>(rbest)].score) rbest = static_cast<int>(i);
+      }
+      if (rbest >= 0 && rdets[static_cast<std::size_t>(rbest)].tof_s > 0) {
+        c_est = dref / rdets[static_cast<std::size_t>(rbest)].tof_s;
+      } else {
+        ref_missed = true;
+      }
+    }
+    std::sort(clipped.begin(), clipped.end());
+    auto clipped_in = [&](long a, long b) {  // [a, b)
+      const auto lo = std::lower_bound(clipped.begin(), clipped.end(), static_cast<std::size_t>(std::max<long>(a, 0)));
+      const auto hi = std::lower_bound(clipped.begin(), clipped.end(), static_cast<std::size_t>(std::max<long>(b, 0)));
+      return static_cast<std::size_t>(hi - lo);
+    };
+    const double ru = s.unambiguous_range_m(eta);
     std::vector<bool> used(dets.size(), false);
     for (std::size_t k = 0; k < train.size(); ++k) {
       Measurement m;
@@ -666,6 +734,12 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       m.true_distance_m = d;
       m.code_sent = train[k].code;
       const double truth = (train[k].tx_s + d / lk.c()) * s.fs;
+      const long own_lo = k == 0 ? 0 : std::lround(truth);
+      const long own_hi = k + 1 < train.size() ? std::lround((train[k + 1].tx_s + d / lk.c()) * s.fs)
+                                               : static_cast<long>(x.size());
+      m.adc_clipped = clipped_in(own_lo, own_hi);
+      m.speed_used = c_est;
+      m.reference_missed = ref_missed;
       int best = -1;
       for (std::size_t i = 0; i < dets.size(); ++i) {
         if (std::abs(dets[i].arrival_s * s.fs - truth) > match) continue;
@@ -675,8 +749,9 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
         used[static_cast<std::size_t>(best)] = true;
         m.detected = true;
         m.det = dets[static_cast<std::size_t>(best)];
-        m.distance_m = m.det.tof_s * lk.c();
+        m.distance_m = m.det.tof_s * c_est;
         m.error_m = m.distance_m - d;
+        m.range_ambiguous = ru > 0 && m.det.code == m.code_sent && std::abs(m.error_m) >= ru / 2.0;
       } else {
         // The paper's metrics at the true alignment, T_d searched to the next burst.
         long end = static_cast<long>(f.size());
@@ -870,8 +945,9 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
   for (const auto& r : rows) dmax = std::max(dmax, r.true_distance_m);
   std::vector<double> usum(eta, 0), un(eta, 0), esum(eta, 0), en(eta, 0), msum(eta, 0), mn(eta, 0);
   std::map<std::pair<int, long long>, std::pair<double, int>> td;  // (code, d) -> sum, n
-  double se = 0;
-  std::size_t nse = 0;
+  double se = 0, se_all = 0;
+  std::size_t nse = 0, nse_all = 0;
+  s.unambiguous_range_m = scene.unambiguous_range_m(s.eta);
   for (const auto& r : rows) {
     if (r.family != family) continue;
     ++s.measurements;
@@ -880,10 +956,19 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
     const bool det_err = !r.detected || r.det.code != r.code_sent;
     s.detector_errors += det_err;
     s.pearson_errors += r.pearson_error;
-    s.decode_errors += det_err || r.pearson_error;
+    s.range_ambiguous += r.range_ambiguous;
+    s.decode_errors += det_err || r.pearson_error || r.range_ambiguous;
     s.td_clipped += r.det.td_clipped;
     s.td_noise_limited += r.det.td_noise_limited;
+    s.clipped_measurements += r.adc_clipped > 0;
+    s.clipped_samples += r.adc_clipped;
+    s.clipped_max = std::max(s.clipped_max, r.adc_clipped);
+    s.reference_missed += r.reference_missed;
     if (!det_err) {
+      se_all += r.error_m * r.error_m;
+      ++nse_all;
+    }
+    if (!det_err && !r.range_ambiguous) {
       se += r.error_m * r.error_m;
       ++nse;
     }
@@ -940,6 +1025,7 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
   s.u_max_over_min = std::isfinite(s.u_min) && s.u_min > 0 ? u_max / s.u_min : nan;
   s.error_rate = s.measurements ? static_cast<double>(s.decode_errors) / static_cast<double>(s.measurements) : 0;
   s.rmse_m = nse ? std::sqrt(se / static_cast<double>(nse)) : nan;
+  s.distance_rmse_with_ambiguous_m = nse_all ? std::sqrt(se_all / static_cast<double>(nse_all)) : nan;
   const double L = scene.range_l();
   s.vmax_hz = s.td_max_s > 0 ? vmax(s.td_max_s, s.eta, scene.speed(), L) : nan;
   return s;

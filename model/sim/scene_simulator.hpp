@@ -25,7 +25,10 @@
 //   T_d      section 2.2 from one chip before the arrival to the end of the stream or the next
 //            detected burst, threshold max(b/10, 4.5 x the noise floor) (duration_td_stream),
 //            flagged when the search range clips it or the noise floor set the threshold.
-// Decode errors count the receiver's misses and misdecodes and the Pearson decoder's misdecodes.
+// Decode errors count the receiver's misses and misdecodes, the Pearson decoder's misdecodes and
+// range-ambiguous (aliased) distances. Input clipping (ADC or the fixed receiver's clamp) is
+// counted per measurement. With a compensation section every measurement's distance is
+// c_est * tof, c_est = d_ref / tof_ref from its reference burst (SceneCompensation).
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -76,13 +79,23 @@ struct Measurement {
   double error_m = 0;          // distance_m - true_distance_m
   double u = 0;                // eq. 10: rho(code_sent) - max rho(other), < 0 on a Pearson misdecode
   bool pearson_error = false;  // the Pearson decoder picked another code (or had no window)
+  // Input clipping: samples of this burst's share of the stream (from its arrival to the next
+  // burst's, the first burst also owning what precedes it) that the ADC clipped (noise.adc), or,
+  // without an ADC stage, that the fixed receiver's input clamp to +-full_scale cut.
+  std::size_t adc_clipped = 0;
+  // Periodic schedule: detected with the right code, but |error| >= eta*c*T / 2: the burst
+  // arrived after the next send of its own code (d at or beyond the unambiguous range) and its
+  // distance aliased. A decode error, excluded from the RMSE.
+  bool range_ambiguous = false;
+  double speed_used = 0;       // c of the ToF -> distance conversion (c_est with compensation)
+  bool reference_missed = false;  // compensation: the reference burst was not detected (receiver c used)
 };
 
 struct FamilySummary {
   std::string family;
   int eta = 0;
   // decode_errors: measurements that the receiver missed or misdecoded, or that the Pearson
-  // decoder misdecoded (the union; the two parts below).
+  // decoder misdecoded, or whose distance aliased (range_ambiguous; the union of the parts below).
   std::size_t measurements = 0, decode_errors = 0, missed = 0, false_alarms = 0;
   std::size_t detector_errors = 0;       // receiver (hardware detector): missed or wrong code
   std::size_t pearson_errors = 0;        // Pearson matched filter: wrong code (u < 0 or no window)
@@ -96,6 +109,12 @@ struct FamilySummary {
   double u_max_over_min = 0;             // max/min of u_per_code (paper: 1.19-1.33 M, 1.85-5.85 Gold)
   double detector_margin_min = 0;        // min over codes of detector_margin_per_code
   std::uint64_t overflows = 0;           // fixed precision: saturations and wraps
+  // Input clipping (Measurement::adc_clipped): measurements with any, total and largest count.
+  std::size_t clipped_measurements = 0, clipped_samples = 0, clipped_max = 0;
+  std::size_t range_ambiguous = 0;       // counted in decode_errors too
+  double unambiguous_range_m = 0;        // eta*c*T (0: single mode)
+  std::size_t reference_missed = 0;      // compensation: reference bursts not detected
+  double distance_rmse_with_ambiguous_m = 0;  // the RMSE had the aliased distances been kept
 };
 
 // What a run writes as a capture: the whole received stream (volts) of one measurement.
