@@ -84,6 +84,58 @@ module measurement_uart #(
     .s_data(byte_now), .s_valid(busy), .s_ready(byte_ready),
     .tx(tx)
   );
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh measurement_uart): the measurement input's stream
+  // rules are assumed, the transmitter's (uart_tx) asserted of the byte multiplexer here.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && !rst && $past(s_valid && !s_ready)) begin
+      assume(s_valid);
+      assume({s_code, s_flags, s_tof, s_distance, s_score, s_margin} ==
+             $past({s_code, s_flags, s_tof, s_distance, s_score, s_margin}));
+    end
+  // Reset state: idle, not ready, line high.
+  always @(posedge clk)
+    if (f_past_valid && $past(rst)) assert(!busy && idx == 0 && !s_ready && tx);
+  // Frame format: the bytes handed to the transmitter are, in order, the 17 bytes of the frame
+  // (sync, fields little-endian, XOR of bytes 2..15), and the measurement is acknowledged with
+  // the last one. f_expect is written from the field list, not from the multiplexer.
+  function [7:0] f_expect(input [4:0] k);
+    reg [7:0] b [0:16];
+    integer i;
+    begin
+      b[0] = 8'hA5; b[1] = 8'h5A; b[2] = s_code; b[3] = s_flags;
+      for (i = 0; i < 4; i = i + 1) begin
+        b[4 + i] = s_tof[8*i +: 8]; b[8 + i] = s_distance[8*i +: 8];
+      end
+      b[12] = s_score[7:0]; b[13] = s_score[15:8]; b[14] = s_margin[7:0]; b[15] = s_margin[15:8];
+      b[16] = 8'h00;
+      for (i = 2; i < 16; i = i + 1) b[16] = b[16] ^ b[i];
+      f_expect = b[k];
+    end
+  endfunction
+  function [7:0] f_xor_upto(input [4:0] k);  // XOR of bytes 2..k-1
+    integer i;
+    begin
+      f_xor_upto = 8'h00;
+      for (i = 2; i < 16; i = i + 1) if (i < k) f_xor_upto = f_xor_upto ^ f_expect(i);
+    end
+  endfunction
+  always @(*)
+    if (f_past_valid && !rst) begin
+      if (busy) begin
+        assert(idx <= BYTES - 1);
+        assert(s_valid);                                  // a frame is only sent for a measurement
+        assert(x == f_xor_upto(idx));                     // the running checksum (induction)
+        assert(byte_now == f_expect(idx));
+      end else begin
+        assert(x == 8'h00 || idx == 0);
+      end
+      assert(s_ready == (busy && idx == BYTES - 1 && byte_ready));
+    end
+`endif
 endmodule
 
 `default_nettype wire
