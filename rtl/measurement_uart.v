@@ -101,35 +101,36 @@ module measurement_uart #(
     if (f_past_valid && $past(rst)) assert(!busy && idx == 0 && !s_ready && tx);
   // Frame format: the bytes handed to the transmitter are, in order, the 17 bytes of the frame
   // (sync, fields little-endian, XOR of bytes 2..15), and the measurement is acknowledged with
-  // the last one. f_expect is written from the field list, not from the multiplexer.
-  function [7:0] f_expect(input [4:0] k);
-    reg [7:0] b [0:16];
-    integer i;
-    begin
-      b[0] = 8'hA5; b[1] = 8'h5A; b[2] = s_code; b[3] = s_flags;
-      for (i = 0; i < 4; i = i + 1) begin
-        b[4 + i] = s_tof[8*i +: 8]; b[8 + i] = s_distance[8*i +: 8];
-      end
-      b[12] = s_score[7:0]; b[13] = s_score[15:8]; b[14] = s_margin[7:0]; b[15] = s_margin[15:8];
-      b[16] = 8'h00;
-      for (i = 2; i < 16; i = i + 1) b[16] = b[16] ^ b[i];
-      f_expect = b[k];
+  // the last one. f_bytes is written from the field list, not from the multiplexer.
+  wire [8*BYTES-1:0] f_bytes;     // byte k at [8k +: 8]
+  wire [8*BYTES-1:0] f_prefix;    // XOR of bytes 2..k-1 at [8k +: 8]
+  assign f_bytes[0 +: 8] = 8'hA5;
+  assign f_bytes[8 +: 8] = 8'h5A;
+  assign f_bytes[16 +: 8] = s_code;
+  assign f_bytes[24 +: 8] = s_flags;
+  genvar f_i;
+  generate
+    for (f_i = 0; f_i < 4; f_i = f_i + 1) begin : g_f_le
+      assign f_bytes[8 * (4 + f_i) +: 8] = s_tof[8 * f_i +: 8];
+      assign f_bytes[8 * (8 + f_i) +: 8] = s_distance[8 * f_i +: 8];
     end
-  endfunction
-  function [7:0] f_xor_upto(input [4:0] k);  // XOR of bytes 2..k-1
-    integer i;
-    begin
-      f_xor_upto = 8'h00;
-      for (i = 2; i < 16; i = i + 1) if (i < k) f_xor_upto = f_xor_upto ^ f_expect(i);
+    for (f_i = 0; f_i < 2; f_i = f_i + 1) begin : g_f_le16
+      assign f_bytes[8 * (12 + f_i) +: 8] = s_score[8 * f_i +: 8];
+      assign f_bytes[8 * (14 + f_i) +: 8] = s_margin[8 * f_i +: 8];
     end
-  endfunction
+    assign f_prefix[0 +: 24] = 24'h0;
+    for (f_i = 3; f_i < BYTES; f_i = f_i + 1) begin : g_f_x
+      assign f_prefix[8 * f_i +: 8] = f_prefix[8 * (f_i - 1) +: 8] ^ f_bytes[8 * (f_i - 1) +: 8];
+    end
+  endgenerate
+  assign f_bytes[8 * 16 +: 8] = f_prefix[8 * 16 +: 8];  // checksum: XOR of bytes 2..15
   always @(*)
     if (f_past_valid && !rst) begin
       if (busy) begin
         assert(idx <= BYTES - 1);
         assert(s_valid);                                  // a frame is only sent for a measurement
-        assert(x == f_xor_upto(idx));                     // the running checksum (induction)
-        assert(byte_now == f_expect(idx));
+        assert(x == f_prefix[8 * idx +: 8]);              // the running checksum (induction)
+        assert(byte_now == f_bytes[8 * idx +: 8]);
       end else begin
         assert(x == 8'h00 || idx == 0);
       end
