@@ -101,6 +101,41 @@ module adc_interface #(
       end
     end
   end
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh adc_interface). Assumed: reset first; m_ready free.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  // Reset state.
+  always @(posedge clk)
+    if (f_past_valid && $past(rst))
+      assert(!m_valid && !tick && !adc_clk && !overrun && overruns == 0 && phase == CLK_DIV - 1 && !primed);
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && !rst) begin
+      // AXI-Stream master: valid stays up until ready; the data changes while waiting only when
+      // the next capture overruns it, and then the overrun is flagged and counted (saturating).
+      if ($past(m_valid && !m_ready)) begin
+        assert(m_valid);
+        if (m_data != $past(m_data))
+          assert(overrun && $past(capture && primed) &&
+                 (overruns == $past(overruns) + 1'b1 || $past(overruns) == {COUNT_W{1'b1}}));
+      end
+      // a new beat only at a capture, and its word is the converted ADC bus
+      if (m_valid && !$past(m_valid)) assert($past(capture && primed));
+      if ($past(capture && primed))
+        assert(m_data == (ADC_OFFSET_BINARY != 0 ? {~$past(pin_q[ADC_W-1]), $past(pin_q[ADC_W-2:0])} : $past(pin_q)));
+      // the overrun flag is sticky, the counter never wraps
+      if ($past(overrun)) assert(overrun);
+      assert(overruns >= $past(overruns));
+      // tick: one clock in CLK_DIV, in the clock after the capture phase
+      assert(tick == $past(capture));
+    end
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(phase <= CLK_DIV - 1);
+      if (overruns != 0) assert(overrun);
+    end
+`endif
 endmodule
 
 `default_nettype wire

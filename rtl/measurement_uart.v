@@ -84,6 +84,59 @@ module measurement_uart #(
     .s_data(byte_now), .s_valid(busy), .s_ready(byte_ready),
     .tx(tx)
   );
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh measurement_uart): the measurement input's stream
+  // rules are assumed, the transmitter's (uart_tx) asserted of the byte multiplexer here.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && !rst && $past(s_valid && !s_ready)) begin
+      assume(s_valid);
+      assume({s_code, s_flags, s_tof, s_distance, s_score, s_margin} ==
+             $past({s_code, s_flags, s_tof, s_distance, s_score, s_margin}));
+    end
+  // Reset state: idle, not ready, line high.
+  always @(posedge clk)
+    if (f_past_valid && $past(rst)) assert(!busy && idx == 0 && !s_ready && tx);
+  // Frame format: the bytes handed to the transmitter are, in order, the 17 bytes of the frame
+  // (sync, fields little-endian, XOR of bytes 2..15), and the measurement is acknowledged with
+  // the last one. f_bytes is written from the field list, not from the multiplexer.
+  wire [8*BYTES-1:0] f_bytes;     // byte k at [8k +: 8]
+  wire [8*BYTES-1:0] f_prefix;    // XOR of bytes 2..k-1 at [8k +: 8]
+  assign f_bytes[0 +: 8] = 8'hA5;
+  assign f_bytes[8 +: 8] = 8'h5A;
+  assign f_bytes[16 +: 8] = s_code;
+  assign f_bytes[24 +: 8] = s_flags;
+  genvar f_i;
+  generate
+    for (f_i = 0; f_i < 4; f_i = f_i + 1) begin : g_f_le
+      assign f_bytes[8 * (4 + f_i) +: 8] = s_tof[8 * f_i +: 8];
+      assign f_bytes[8 * (8 + f_i) +: 8] = s_distance[8 * f_i +: 8];
+    end
+    for (f_i = 0; f_i < 2; f_i = f_i + 1) begin : g_f_le16
+      assign f_bytes[8 * (12 + f_i) +: 8] = s_score[8 * f_i +: 8];
+      assign f_bytes[8 * (14 + f_i) +: 8] = s_margin[8 * f_i +: 8];
+    end
+    assign f_prefix[0 +: 24] = 24'h0;
+    for (f_i = 3; f_i < BYTES; f_i = f_i + 1) begin : g_f_x
+      assign f_prefix[8 * f_i +: 8] = f_prefix[8 * (f_i - 1) +: 8] ^ f_bytes[8 * (f_i - 1) +: 8];
+    end
+  endgenerate
+  assign f_bytes[8 * 16 +: 8] = f_prefix[8 * 16 +: 8];  // checksum: XOR of bytes 2..15
+  always @(*)
+    if (f_past_valid && !rst) begin
+      if (busy) begin
+        assert(idx <= BYTES - 1);
+        assert(s_valid);                                  // a frame is only sent for a measurement
+        assert(x == f_prefix[8 * idx +: 8]);              // the running checksum (induction)
+        assert(byte_now == f_bytes[8 * idx +: 8]);
+      end else begin
+        assert(x == 8'h00 || idx == 0);
+      end
+      assert(s_ready == (busy && idx == BYTES - 1 && byte_ready));
+    end
+`endif
 endmodule
 
 `default_nettype wire

@@ -77,23 +77,42 @@ module tx_scheduler #(
   reg [HW-1:0]     ph;         // 2 CYC s mod 2 SPC
 
   wire [CODES*CHIPS-1:0] code_bits = CODE_BITS;
-  // The chip lookups (a CODES*CHIPS-to-1 multiplexer) are registered every clock: code_idx and
-  // chip change only on a tick and ticks are at least 2 clocks apart (CLK_DIV >= 2), so at the
-  // next tick they are current, and the lookup is off the tick's critical path.
+  // Every decision a tick takes is registered in the clock before it: the state (code_idx,
+  // chip, s, ph, t) changes only on a tick and ticks are at least 2 clocks apart (CLK_DIV >= 2,
+  // adc_interface), so a register loaded from the state every clock is current at the next
+  // tick. This keeps the chip lookup (a CODES*CHIPS-to-1 multiplexer), the phase compare and
+  // step, and the counters' end tests off the tick's paths. In reset they take the values of
+  // the reset state.
   reg chip_bit, first_positive;
+  reg ph_low;                  // ph < SPC
+  reg [HW-1:0] ph_next;        // (ph + 2 CYC) mod 2 SPC
+  reg t_zero, t_last, s_last, chip_last, code_last;
+  wire [HW:0] ph_step = {1'b0, ph} + 2 * CYC;
   always @(posedge clk) begin
     chip_bit <= code_bits[code_idx * CHIPS + chip];
     first_positive <= code_bits[code_idx * CHIPS];
+    if (rst) begin
+      ph_low <= 1'b1;
+      ph_next <= 2 * CYC >= 2 * SPC ? (2 * CYC) % (2 * SPC) : 2 * CYC;
+      t_zero <= 1'b1; t_last <= PERIOD_T == 1; s_last <= SPC == 1; chip_last <= CHIPS == 1;
+      code_last <= CODES == 1;
+    end else begin
+      ph_low <= ph < SPC;
+      ph_next <= ph_step >= 2 * SPC ? ph_step - 2 * SPC : ph_step[HW-1:0];
+      t_zero <= t == 0;
+      t_last <= t == PERIOD_T - 1;
+      s_last <= s == SPC - 1;
+      chip_last <= chip == CHIPS - 1;
+      code_last <= code_idx == CODES - 1;
+    end
   end
-  // (c+1) SPC mod 2 SPC: 0 for a chip 1, SPC for a chip 0.
-  wire [HW:0] ph_full = {1'b0, ph} + (chip_bit ? {(HW+1){1'b0}} : SPC[HW:0]);
-  wire [HW:0] ph_mod  = ph_full >= 2 * SPC ? ph_full - 2 * SPC : ph_full;
-  wire        positive = ph_mod < SPC;
+  // ph_mod = (ph + (c+1) SPC) mod 2 SPC, (c+1) SPC mod 2 SPC being 0 for a chip 1 and SPC for a
+  // chip 0; ph_mod < SPC is then ph < SPC for a chip 1 and ph >= SPC for a chip 0.
+  wire positive = chip_bit ? ph_low : ~ph_low;
 
   // First sample of a burst: chip 0 of the code about to start, phase 0: +1 for a chip 1
   // (first_positive, registered above).
-  wire start_now = tick && (t == 0) && enable;
-  wire [HW:0] ph_step = {1'b0, ph} + 2 * CYC;
+  wire start_now = tick && t_zero && enable;
   assign burst_valid = start_now;
   assign burst_code = code_idx + 1'b1;
   assign burst_time = n;
@@ -104,7 +123,7 @@ module tx_scheduler #(
       hb_p <= 1'b0; hb_n <= 1'b0; tx_active <= 1'b0;
     end else if (tick) begin
       n <= n + 1'b1;
-      t <= (t == PERIOD_T - 1) ? {PW{1'b0}} : t + 1'b1;
+      t <= t_last ? {PW{1'b0}} : t + 1'b1;
       if (start_now || in_burst) begin
         // Sample of the burst at (chip, s): drive it, then advance.
         if (start_now) begin
@@ -121,19 +140,19 @@ module tx_scheduler #(
           chip <= 0;
           s <= 1;
           ph <= 2 * CYC >= 2 * SPC ? (2 * CYC) % (2 * SPC) : 2 * CYC;
-        end else if (s == SPC - 1) begin
+        end else if (s_last) begin
           s <= 0;
           ph <= 0;
-          if (chip == CHIPS - 1) begin
+          if (chip_last) begin
             in_burst <= 1'b0;
             chip <= 0;
-            code_idx <= (code_idx == CODES - 1) ? {CODE_W{1'b0}} : code_idx + 1'b1;
+            code_idx <= code_last ? {CODE_W{1'b0}} : code_idx + 1'b1;
           end else begin
             chip <= chip + 1'b1;
           end
         end else begin
           s <= s + 1'b1;
-          ph <= ph_step >= 2 * SPC ? ph_step - 2 * SPC : ph_step[HW-1:0];
+          ph <= ph_next;
         end
       end else begin
         hb_p <= 1'b0;
@@ -143,6 +162,37 @@ module tx_scheduler #(
     end
   end
 
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh tx_scheduler). Assumed: reset first, ticks at least
+  // 2 clocks apart (adc_interface's strobe, CLK_DIV >= 2).
+  reg f_past_valid = 1'b0;
+  reg f_tick_q = 1'b0;
+  always @(posedge clk) begin f_past_valid <= 1'b1; f_tick_q <= tick; end
+  always @(*) if (!f_past_valid) assume(rst);
+  always @(*) if (f_tick_q) assume(!tick);
+  // Reset state: both H-bridge legs off, no burst, counters at 0.
+  always @(posedge clk)
+    if (f_past_valid && $past(rst))
+      assert(!hb_p && !hb_n && !tx_active && !in_burst && n == 0 && t == 0 && code_idx == 0);
+  // phase model: ph = 2 CYC s mod 2 SPC (hbridge_drive's phase without the chip offset)
+  wire [HW+SW+8:0] f_ph = (2 * CYC * s) % (2 * SPC);
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(!(hb_p && hb_n));                     // never both legs on (shoot-through)
+      assert(tx_active == (hb_p || hb_n));         // a leg is on exactly while transmitting
+      if (burst_valid) assert(burst_code >= 1 && burst_code <= CODES);
+      assert(code_idx < CODES && t < PERIOD_T && chip < CHIPS && s < SPC && ph < 2 * SPC);
+      if (in_burst) assert(ph == f_ph);
+      if (!in_burst) assert(chip == 0 && s == 0);
+      // the registered decisions are current whenever a tick can come
+      if (!f_tick_q) begin
+        assert(t_zero == (t == 0) && t_last == (t == PERIOD_T - 1) && s_last == (s == SPC - 1));
+        assert(chip_last == (chip == CHIPS - 1) && code_last == (code_idx == CODES - 1));
+        assert(ph_low == (ph < SPC));
+        assert(ph_next == (ph + 2 * CYC) % (2 * SPC));
+      end
+    end
+`endif
 endmodule
 
 `default_nettype wire

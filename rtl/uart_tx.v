@@ -56,6 +56,63 @@ module uart_tx #(
       end
     end
   end
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh uart_tx). As the top (F_UART_TX defined) the stream
+  // rules of the input are assumed; inside measurement_uart they are asserted of its driver.
+`ifdef F_UART_TX
+`define UT_ASSUME assume
+`else
+`define UT_ASSUME assert
+`endif
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+`ifdef F_UART_TX
+  always @(*) if (!f_past_valid) assume(rst);
+`endif
+  // AXI-Stream input: valid stays up until ready, the byte stays stable while waiting.
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && !rst && $past(s_valid && !s_ready)) begin
+      `UT_ASSUME(s_valid);
+      `UT_ASSUME(s_data == $past(s_data));
+    end
+  // Reset state: line high (idle), ready, counters cleared.
+  always @(posedge clk)
+    if (f_past_valid && $past(rst)) assert(tx && bits == 0 && count == 0 && s_ready);
+  // Frame format: a shadow transmitter of the 8N1 frame, bit k (1 start, 2..9 data LSB first,
+  // 10 stop) for BAUD_DIV clocks each; the line equals the shadow's bit in every clock.
+  reg [3:0]    f_bit;   // 0 idle
+  reg [CW-1:0] f_cnt;   // clocks of the current bit so far
+  reg [7:0]    f_byte;
+  always @(posedge clk)
+    if (rst) begin
+      f_bit <= 0; f_cnt <= 0;
+    end else if (f_bit == 0) begin
+      if (s_valid) begin f_bit <= 1; f_cnt <= 0; f_byte <= s_data; end
+    end else if (f_cnt == BAUD_DIV - 1) begin
+      f_cnt <= 0;
+      f_bit <= (f_bit == 10) ? 4'd0 : f_bit + 1'b1;
+    end else begin
+      f_cnt <= f_cnt + 1'b1;
+    end
+  wire [17:0] f_rest = {9'h1ff, 1'b1, f_byte} >> (f_bit - 1);
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(s_ready == (f_bit == 0));
+      if (f_bit == 0) assert(tx);                  // idle line high
+      else if (f_bit == 1) assert(!tx);            // start bit
+      else if (f_bit == 10) assert(tx);            // stop bit
+      else assert(tx == f_byte[f_bit - 2]);        // data, LSB first
+      // invariants linking the shadow to the state (they make the induction close)
+      assert(f_bit <= 10);
+      assert(bits == (f_bit == 0 ? 4'd0 : 4'd11 - f_bit));
+      if (f_bit != 0) begin
+        assert(f_cnt <= BAUD_DIV - 1);
+        assert(count == BAUD_DIV - 1 - f_cnt);
+        assert(shift == f_rest[8:0]);
+      end
+    end
+`undef UT_ASSUME
+`endif
 endmodule
 
 `default_nettype wire

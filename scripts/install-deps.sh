@@ -10,7 +10,8 @@ packages=(build-essential cmake g++ libgtest-dev libgmock-dev libbenchmark-dev l
           parallel  # the GNU parallel sweep recipe and its test (docs/design-space.md)
           clang libclang-rt-14-dev)  # clang + libFuzzer: tests/fuzz (RANGING_FUZZ=ON)
 if [[ "${1:-}" == "--hardware" ]]; then
-  packages+=(verilator iverilog yosys nextpnr-ice40 fpga-icestorm gtkwave)
+  packages+=(verilator iverilog yosys nextpnr-ice40 fpga-icestorm gtkwave
+             z3)  # solver of yosys-smtbmc: formal/ (ctest label formal)
 fi
 if [[ "${1:-}" == "--cluster" ]]; then
   packages+=(slurm-wlm munge)

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "model/base/error.hpp"
+#include "model/hw/frames.hpp"
 #include "model/sim/capture.hpp"
 #include "tests/fuzz/fuzz_entry.hpp"
 
@@ -55,6 +56,33 @@ TEST(FuzzRegressions, CaptureCsv) {
 }
 TEST(FuzzRegressions, CaptureWav) {
   EXPECT_GE(replay(ranging::fuzz::capture_wav, {kSrc + "/tests/fuzz/seeds/capture_wav", kReg + "capture_wav"}), 5u);
+}
+
+TEST(FuzzRegressions, UartFrames) {
+  EXPECT_GE(replay(ranging::fuzz::uart_frames, {kSrc + "/tests/fuzz/seeds/uart_frames", kReg + "uart_frames"}), 4u);
+}
+TEST(FuzzRegressions, SweepSpec) {
+  auto entry = [](const std::uint8_t* d, std::size_t n) { return ranging::fuzz::sweep_spec(d, n, kSrc); };
+  EXPECT_GE(replay(entry, {kSrc + "/tests/fuzz/seeds/sweep_spec", kReg + "sweep_spec"}), 3u);
+}
+
+// The seeds of the uart_frames target decode as built: whole frames, and a stream with noise,
+// a bad checksum and a frame cut short.
+TEST(FuzzRegressions, UartFramesSeedsDecode) {
+  const std::string bytes = slurp(kSrc + "/tests/fuzz/seeds/uart_frames/three-frames.bin");
+  ranging::FrameStats st;
+  const auto frames = ranging::decode_uart_frames(
+      std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()), st);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[1].tof_q8, 0xffffffffu);
+  EXPECT_EQ(frames[2].code, 9);
+  const std::string noisy = slurp(kSrc + "/tests/fuzz/seeds/uart_frames/noise-bad-truncated.bin");
+  ranging::FrameStats st2;
+  const auto f2 = ranging::decode_uart_frames(
+      std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(noisy.data()), noisy.size()), st2);
+  EXPECT_EQ(f2.size(), 1u);  // the bad-checksum frame and the truncated one are not frames
+  EXPECT_GE(st2.bad_frames, 1u);
+  EXPECT_TRUE(st2.truncated);
 }
 
 // The hostile inputs are refused (not merely survived), with the file's line where it has one.

@@ -1,5 +1,5 @@
 // Interruption (issue 18, section 5): SIGINT or SIGTERM during `ranging simulate` or
-// `ranging evaluate` leaves the previous outputs intact and no partial or temporary file, and
+// `ranging sweep` leaves the previous outputs intact and no partial or temporary file, and
 // a re-run succeeds. The tool dies of the signal (its handler unlinks the temporaries of
 // model/base/atomic_file.hpp and re-raises), so the exit is "killed by SIGINT/SIGTERM".
 #include <gtest/gtest.h>
@@ -17,6 +17,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "tests/process.hpp"
 
@@ -92,6 +94,41 @@ TEST_P(Interrupt, SimulateLeavesPreviousOutputsAndNoTemporaries) {
   const auto again = ranging::testing_support::run_tool("simulate --quiet " + (dir / "short.yaml").string() + " --out " + out);
   EXPECT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(files_in(out), before);
+  fs::remove_all(dir);
+}
+
+// A sweep interrupted part-way leaves only whole files (every point file parses, no temporary,
+// no half-written sweep.json), and a re-run into the same folder resumes: the points done
+// before are kept, the rest are evaluated, and the outputs are complete.
+TEST(InterruptSweep, SigtermLeavesWholePointFilesAndResumes) {
+  const int sig = SIGTERM;
+  const fs::path dir = fs::temp_directory_path() / ("ranging_int_sweep_" + std::to_string(::getpid()) + "_" + std::to_string(sig));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string src = RANGING_SOURCE_DIR;
+  std::ofstream(dir / "spec.yaml") << "name: int\nconfig: " << src << "/configs/default.yaml\nscene: " << src
+                                   << "/sweeps/smoke-scene.yaml\nmode: grid\naxes:\n"
+                                      "  - key: correlator_fixed.chip_bits\n    range: {from: 14, to: 20, step: 2}\n";
+  const std::string out = (dir / "out").string();
+  const int status = run_and_signal({"sweep", (dir / "spec.yaml").string(), "--no-synth", "--quiet", "--out", out}, sig,
+                                    std::chrono::milliseconds(1500));
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the sweep ended before the signal: make the spec longer";
+  EXPECT_EQ(WTERMSIG(status), sig);
+  std::size_t kept = 0;
+  for (const auto& [name, text] : files_in(out)) {
+    EXPECT_EQ(name.find(".tmp-"), std::string::npos) << "temporary left: " << name;
+    EXPECT_NE(name, "sweep.json") << "the interrupted sweep wrote its final document";
+    if (name.rfind("points/", 0) == 0) {
+      EXPECT_TRUE(nlohmann::json::accept(text)) << name << " is not whole JSON";
+      ++kept;
+    }
+  }
+  const auto again = ranging::testing_support::run_tool("sweep " + (dir / "spec.yaml").string() + " --no-synth --out " + out);
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_NE(again.err.find(std::to_string(kept) + " done before"), std::string::npos) << again.err;
+  const auto doc = nlohmann::json::parse(slurp(fs::path(out) / "sweep.json"));
+  ASSERT_TRUE(doc.contains("points"));
+  EXPECT_EQ(doc["points"].size(), 5u);  // 4 values of the axis and the base point
   fs::remove_all(dir);
 }
 

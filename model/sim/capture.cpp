@@ -115,7 +115,11 @@ CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& 
   }
   if (!j.is_object()) throw InputError(origin + ": expected a JSON object of capture metadata");
   CaptureMeta m;
-  for (const auto& [key, v] : j.items()) {
+  for (const auto& item : j.items()) {
+    // plain references, not a structured binding: clang 14 (the fuzz build) cannot capture
+    // structured bindings in the lambdas below
+    const std::string& key = item.key();
+    const nlohmann::json& v = item.value();
     auto num = [&]() {
       if (!v.is_number()) throw InputError(origin + ": key " + key + ": expected a number");
       return v.get<double>();

@@ -3,14 +3,22 @@
 // unit test that replays the seeds and every regression input (tests/test_fuzz_regressions.cpp).
 // Contract under test: any input either parses or is refused with ranging::InputError; any
 // other exception, a crash, a leak or undefined behaviour is a bug.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <span>
+#include <stdexcept>
 #include <string>
+#include <unistd.h>
 
 #include "model/base/error.hpp"
 #include "model/config/receiver_config.hpp"
+#include "model/hw/frames.hpp"
 #include "model/sim/capture.hpp"
 #include "model/sim/scene.hpp"
+#include "model/study/sweep.hpp"
 
 namespace ranging::fuzz {
 
@@ -45,6 +53,68 @@ inline int capture_csv(const std::uint8_t* data, std::size_t size) {
 inline int capture_wav(const std::uint8_t* data, std::size_t size) {
   try {
     (void)parse_capture_wav(text_of(data, size), "fuzz.wav");
+  } catch (const InputError&) {
+  }
+  return 0;
+}
+
+// UART frame decoder (model/hw/frames.cpp) on any byte stream. Besides not crashing, the
+// decoder's own contract is checked: every frame it returns starts with the sync at its offset
+// and re-encodes to the very bytes of the stream there, frames do not overlap, the counters
+// account for no more bytes than the stream holds, and a stream of only whole frames decodes
+// back to them. A violation aborts (a finding).
+inline int uart_frames(const std::uint8_t* data, std::size_t size) {
+  const std::span<const std::uint8_t> bytes(data, size);
+  FrameStats st;
+  const std::vector<UartFrame> frames = decode_uart_frames(bytes, st);
+  if (st.bytes != size) throw std::logic_error("FrameStats.bytes != stream size");
+  std::uint64_t end = 0;
+  for (const UartFrame& f : frames) {
+    if (f.offset < end || f.offset + kUartFrameBytes > size) throw std::logic_error("frame outside the stream or overlapping");
+    const std::vector<std::uint8_t> enc = encode_uart_frame(f);
+    if (enc.size() != kUartFrameBytes || !std::equal(enc.begin(), enc.end(), data + f.offset))
+      throw std::logic_error("decoded frame does not re-encode to the stream's bytes");
+    end = f.offset + kUartFrameBytes;
+  }
+  if (frames.size() * kUartFrameBytes + st.skipped_bytes > size) throw std::logic_error("bytes counted twice");
+  // Round trip: the decoded frames, encoded back to back, decode to themselves with nothing skipped.
+  std::vector<std::uint8_t> clean;
+  for (const UartFrame& f : frames) {
+    const auto e = encode_uart_frame(f);
+    clean.insert(clean.end(), e.begin(), e.end());
+  }
+  FrameStats st2;
+  const auto again = decode_uart_frames(clean, st2);
+  if (again.size() != frames.size() || st2.bad_frames != 0 || st2.skipped_bytes != 0 || st2.truncated)
+    throw std::logic_error("clean stream of decoded frames does not decode back");
+  return 0;
+}
+
+// Sweep spec (model/study/sweep.cpp load_sweep_spec, then the point list). The spec is a file
+// whose config: and scene: are resolved relative to it, so each input is written to a private
+// folder that holds copies of configs/default.yaml (as default.yaml) and
+// sweeps/smoke-scene.yaml (as smoke-scene.yaml); source_dir is the repository.
+inline int sweep_spec(const std::uint8_t* data, std::size_t size, const std::string& source_dir) {
+  namespace fs = std::filesystem;
+  static const fs::path dir = [&] {
+    const fs::path d = fs::temp_directory_path() / ("ranging-fuzz-sweep-" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    fs::copy_file(fs::path(source_dir) / "configs/default.yaml", d / "default.yaml", fs::copy_options::overwrite_existing);
+    fs::copy_file(fs::path(source_dir) / "sweeps/smoke-scene.yaml", d / "smoke-scene.yaml", fs::copy_options::overwrite_existing);
+    return d;
+  }();
+  const fs::path spec = dir / "spec.yaml";
+  {
+    std::ofstream out(spec, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  }
+  try {
+    const study::SweepSpec s = study::load_sweep_spec(spec.string());
+    // Expand the points only when the grid is of a reasonable size (a spec may legitimately
+    // ask for millions of points; that is not a parser bug).
+    double n = 1;
+    for (const auto& a : s.axes) n *= static_cast<double>(a.values.size());
+    if (n <= 5000 && s.points <= 5000) (void)study::sweep_points(s);
   } catch (const InputError&) {
   }
   return 0;
