@@ -128,7 +128,7 @@ const std::vector<std::string>& receiver_rtl_sources() {
 
 const std::vector<std::string>& system_rtl_sources() {
   static const std::vector<std::string> v{"adc_interface.v", "tx_scheduler.v", "tof_distance.v",
-                                          "uart_tx.v",       "measurement_uart.v", "ranging_system.v"};
+                                          "uart_tx.v",       "measurement_uart.v", "sound_speed_cal.v", "ranging_system.v"};
   return v;
 }
 
