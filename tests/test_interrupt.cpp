@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -64,6 +65,34 @@ int run_and_signal(const std::vector<std::string>& args, int sig, std::chrono::m
   return status;
 }
 
+// As run_and_signal, but the signal is sent as soon as ready() holds (polled every 20 ms, at most
+// `limit`): the interruption falls mid-run whatever the machine's speed.
+int run_and_signal_when(const std::vector<std::string>& args, int sig, const std::function<bool()>& ready,
+                        std::chrono::milliseconds limit) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    std::string tool = RANGING_TOOL;
+    argv.push_back(tool.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    const int devnull = ::open("/dev/null", O_WRONLY);
+    ::dup2(devnull, 1);
+    ::dup2(devnull, 2);
+    ::execv(tool.c_str(), argv.data());
+    ::_exit(127);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!ready() && std::chrono::steady_clock::now() - t0 < limit) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(pid, sig);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return status;
+}
+
 class Interrupt : public ::testing::TestWithParam<int> {};
 
 TEST_P(Interrupt, SimulateLeavesPreviousOutputsAndNoTemporaries) {
@@ -106,12 +135,23 @@ TEST(InterruptSweep, SigtermLeavesWholePointFilesAndResumes) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string src = RANGING_SOURCE_DIR;
-  std::ofstream(dir / "spec.yaml") << "name: int\nconfig: " << src << "/configs/default.yaml\nscene: " << src
-                                   << "/sweeps/smoke-scene.yaml\nmode: grid\naxes:\n"
+  // Ten distances per point (about a second each here), five points; the signal comes as soon
+  // as the first point file is there.
+  std::ofstream(dir / "scene.yaml") << "name: int-scene\ngeometry:\n  distances_m: [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, "
+                                       "0.8, 0.9, 1.0]\nexcitation:\n  family: Gold4\nnoise:\n  noise_v: 0.01\n  seed: 1\n";
+  std::ofstream(dir / "spec.yaml") << "name: int\nconfig: " << src << "/configs/default.yaml\nscene: "
+                                   << (dir / "scene.yaml").string() << "\nmode: grid\naxes:\n"
                                       "  - key: correlator_fixed.chip_bits\n    range: {from: 14, to: 20, step: 2}\n";
   const std::string out = (dir / "out").string();
-  const int status = run_and_signal({"sweep", (dir / "spec.yaml").string(), "--no-synth", "--quiet", "--out", out}, sig,
-                                    std::chrono::milliseconds(1500));
+  auto first_point = [&] {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(fs::path(out) / "points", ec)) {
+      if (e.path().extension() == ".json") return true;
+    }
+    return false;
+  };
+  const int status = run_and_signal_when({"sweep", (dir / "spec.yaml").string(), "--no-synth", "--quiet", "--out", out},
+                                         sig, first_point, std::chrono::milliseconds(60000));
   ASSERT_TRUE(WIFSIGNALED(status)) << "the sweep ended before the signal: make the spec longer";
   EXPECT_EQ(WTERMSIG(status), sig);
   std::size_t kept = 0;
