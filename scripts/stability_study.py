@@ -156,8 +156,32 @@ def main() -> int:
         L.append("| %s | %.4f | %.4f | %.4f | %.4f | %.3f | %d |" % (h["node"], h["l1_gain"], h["peak_bound"], h["measured_peak"],
                                                                    h["limit"], h["headroom_bits"], h["overflows"]))
     L.append("")
-    L.append("Not yet measured here: the correlator bank's nodes under their worst-case inputs and the same "
-             "sequences through the Verilator RTL (issue 12, section 4).\n")
+    L.append("The filter's worst-case sequences also run through the Verilator RTL, equal to the model "
+             "(`tb_bandpass_sos`).\n")
+    L.append("## Correlator bank headroom per node\n")
+    L.append("`model/dsp/correlator_headroom.hpp`: each node of the bank is linear in its input up to the "
+             "quantizers, so its L1 bound (plus every rounding) is exact, and the full-scale sign sequence of "
+             "its sensitivity is its worst-case input; every node is driven by its own (re and im, both "
+             "polarities, every code for C_j / C_q, whose worst case also gives P_j and Q_j). Values in "
+             "each node's own LSB; for a saturating node the bound is the value its input demands. The same "
+             "sequences run through the Verilator RTL and equal the model "
+             "(`CorrelatorBankRtl.BitExactOnEveryNodesWorstCase`).\n")
+    L.append("| node | bits | claim | bound | measured peak | limit | headroom (bits) | overflows |")
+    L.append("|---|---|---|---|---|---|---|---|")
+    for h in j["bank_headroom"]:
+        L.append("| %s | %d | %s | %.6g | %.6g | %.6g | %.3f | %d |" % (h["node"], h["bits"], h["claim"], h["bound"],
+                                                                    h["measured_peak"], h["limit"], h["headroom_bits"],
+                                                                    h["overflows"]))
+    L.append("")
+    neg = [h for h in j["bank_headroom"] if h["headroom_bits"] < 0]
+    if neg:
+        L.append("Negative headroom (a worst-case input saturates the word, counted): " +
+                 ", ".join("%s %.3f bits" % (h["node"], h["headroom_bits"]) for h in neg) +
+                 ". These words are sized so that a full-scale code template peaks 6 dB below their top "
+                 "(`resolve_correlator_layout`); the worst case is a full-scale sign sequence no echo produces.\n")
+    L.append("The exhaustive limit-cycle search over every initial state and the scene extremes (ADC "
+             "clipping, range, SNR, temperature, ambiguity, amplitude, ADC faults) are in "
+             "[stability-extremes.md](stability-extremes.md).\n")
     with open(os.path.join(out, "stability.md"), "w") as f:
         f.write("\n".join(L))
     return 0

@@ -23,6 +23,7 @@
 
 #include "model/config/receiver_config.hpp"
 #include "model/dsp/bandpass_filter.hpp"
+#include "model/dsp/correlator_headroom.hpp"
 #include "model/sim/channel.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/receiver.hpp"
@@ -361,6 +362,50 @@ TEST(CorrelatorBankRtl, BitExactOnCodedBurstsAndWorstCase) {
   EXPECT_EQ(g_totals.mismatches, 0u) << g_totals.first;
   // every run is compared to its end: about one output per DECIM inputs
   EXPECT_GT(g_totals.outputs, g_totals.inputs / static_cast<std::uint64_t>(2 * d.layout.decimation));
+}
+
+// Issue 12 section 4: every node's own worst-case input (model/dsp/correlator_headroom.hpp: the
+// full-scale sign sequence of the node's sensitivity, re and im, both polarities, every code for
+// the combiner) through the RTL, which must equal the model on every output, including the
+// chip filter's saturations that the worst case provokes.
+TEST(CorrelatorBankRtl, BitExactOnEveryNodesWorstCase) {
+  const auto& d = design();
+  const auto& cfg = d.config.correlator;
+  BankSim sim;
+  std::mt19937_64 rng(99);
+  const Totals before = g_totals;
+  std::uint64_t saturating_runs = 0;
+  int case_no = 0;
+  auto drive = [&](BankNode n, int code, bool im, bool neg) {
+    const std::vector<std::int64_t> y = correlator_worst_case(d.reference, cfg, n, code, im, neg);
+    CorrelatorBankFixed probe(d.reference, cfg);
+    for (std::int64_t v : y) probe.execute(v);
+    if (probe.overflow_events().total() > 0) ++saturating_runs;
+    RunOpts o;
+    if (case_no++ % 2 == 1) {
+      o.gap = 0.3;
+      o.stall = 0.3;
+    }
+    run(sim, y, o, rng, std::string(bank_node_name(n)) + " worst case, code " + std::to_string(code + 1) +
+                            (im ? " im" : " re") + (neg ? " negated" : ""));
+  };
+  for (bool neg : {false, true}) {
+    for (bool im : {false, true}) {
+      for (BankNode n : {BankNode::Mixer, BankNode::Decimator, BankNode::ChipFir}) drive(n, 0, im, neg);
+      for (int j = 0; j < static_cast<int>(d.family.codes.size()); ++j) drive(BankNode::CorrQ, j, im, neg);
+    }
+    drive(BankNode::Energy, 0, false, neg);
+  }
+  std::printf("correlator_bank worst cases: %llu input samples, %llu outputs compared, %llu runs saturating\n",
+              static_cast<unsigned long long>(g_totals.inputs - before.inputs),
+              static_cast<unsigned long long>(g_totals.outputs - before.outputs),
+              static_cast<unsigned long long>(saturating_runs));
+  EXPECT_EQ(g_totals.mismatches, before.mismatches) << g_totals.first;
+  EXPECT_GT(g_totals.outputs - before.outputs, 0u);
+  // The RTL saw the saturations the headroom analysis predicts (F_q at the default words).
+  bool predicted = false;
+  for (const auto& h : correlator_headroom(d.reference, cfg)) predicted |= !h.exact && h.headroom_bits < 0;
+  EXPECT_EQ(saturating_runs > 0, predicted);
 }
 
 // Throughput at the default configuration: one input every 6 clocks (5 MS/s at 30 MHz). The

@@ -154,7 +154,7 @@ TEST(SceneExtremes, AttenuationFromTwoToFiveMetresCountsMisses) {
 }
 
 // SNR +40 dB: no error, ToF spread < 0.1 us; -12 dB: errors > 0 and a larger ToF spread of the
-// bursts still decoded right (curves: scripts/snr_curve.py, docs/results/stability.md).
+// bursts still decoded right (curves: scripts/snr_curve.py, docs/results/stability-extremes.md).
 TEST(SceneExtremes, SnrFromPlusFortyToMinusTwelve) {
   auto at = [](double snr) {
     return run("transducers: {}\ngeometry:\n  distances_m: [0.5]\n  repeats: 4\nexcitation:\n  family: Gold4\n"

@@ -1,7 +1,7 @@
 // `ranging stability --config FILE`: numerical stability report of a receiver configuration
 // (issue 12): the guard's verdict on the quantized filter (model/dsp/stability.hpp) with its
-// exact pole radii and edge attenuations, overflow headroom per filter node under the
-// worst-case input, zero-input limit cycles per rounding / overflow mode and excitation,
+// exact pole radii and edge attenuations, overflow headroom per filter node and per correlator
+// bank node (model/dsp/correlator_headroom.hpp) under its worst-case input, zero-input limit cycles per rounding / overflow mode and excitation,
 // their amplitude against the data and coefficient word lengths, and the filter-structure
 // comparison (SOS vs direct form, per filter type: minimal coefficient bits, pole radius vs
 // bits). The report never refuses the design: it is where an out-of-spec one is studied.
@@ -18,6 +18,8 @@
 #include "model/base/error.hpp"
 #include "model/config/receiver_config.hpp"
 #include "model/dsp/bandpass_filter.hpp"
+#include "model/dsp/correlator_headroom.hpp"
+#include "model/dsp/receiver.hpp"
 #include "model/dsp/limit_cycle_search.hpp"
 #include "model/dsp/stability.hpp"
 #include "tool/cli.hpp"
@@ -80,7 +82,7 @@ int cmd_stability(const Args& args) {
   cli::Parser p("ranging stability",
                 "Numerical stability report of a receiver configuration: the guard's verdict on the\n"
                 "quantized filter (exact pole radii, edge attenuations), overflow headroom per filter\n"
-                "node under its worst-case input, zero-input limit cycles per rounding and overflow\n"
+                "and correlator-bank node under its worst-case input, zero-input limit cycles per rounding and overflow\n"
                 "mode, and the SOS vs direct-form comparison per filter type. An out-of-spec design\n"
                 "is reported, not refused.");
   p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md); default: the built-in default");
@@ -137,6 +139,23 @@ int cmd_stability(const Args& args) {
     }
   }
   j["headroom"] = head;
+
+  // The correlator bank, node by node (model/dsp/correlator_headroom.hpp): each node's bound,
+  // and the node driven by its own full-scale worst-case sign sequences in the model.
+  json bank_head = json::array();
+  {
+    const ReceiverDesign d = design_receiver(cfg);
+    for (const BankNodeHeadroom& h : correlator_headroom(d.reference, cfg.correlator)) {
+      json n{{"node", h.name},       {"bits", h.bits},
+             {"claim", h.exact ? "exact" : "saturate (counted)"},
+             {"bound", h.bound},     {"measured_peak", h.measured},
+             {"limit", h.limit},     {"headroom_bits", h.headroom_bits},
+             {"overflows", h.overflows}};
+      if (h.worst_code >= 0) n["worst_code"] = h.worst_code + 1;
+      bank_head.push_back(n);
+    }
+  }
+  j["bank_headroom"] = bank_head;
 
   // Limit cycles at the configuration's words, every mode and excitation.
   json lcs = json::array();
@@ -279,6 +298,17 @@ int cmd_stability(const Args& args) {
                   h["node"].get<std::string>().c_str(), h["l1_gain"].get<double>(), h["peak_bound"].get<double>(),
                   h["measured_peak"].get<double>(), h["limit"].get<double>(), h["headroom_bits"].get<double>(),
                   static_cast<unsigned long long>(h["overflows"].get<std::uint64_t>()));
+    os << buf;
+  }
+  os << "\ncorrelator bank headroom per node (full-scale worst-case sign sequences, re and im, both\n"
+        "polarities, every code; values in each node's own LSB; a saturating node's bound is the\n"
+        "value its input demands):\n"
+        "  node                        bits  claim               bound      measured   limit      headroom  overflows\n";
+  for (const auto& h : bank_head) {
+    std::snprintf(buf, sizeof buf, "  %-27s %4d  %-18s %10.4g %10.4g %10.4g %7.3f b %6llu\n",
+                  h["node"].get<std::string>().c_str(), h["bits"].get<int>(), h["claim"].get<std::string>().c_str(),
+                  h["bound"].get<double>(), h["measured_peak"].get<double>(), h["limit"].get<double>(),
+                  h["headroom_bits"].get<double>(), static_cast<unsigned long long>(h["overflows"].get<std::uint64_t>()));
     os << buf;
   }
   os << "\nzero-input limit cycles after each excitation (amplitude in data LSB, period in samples;\n"

@@ -312,7 +312,10 @@ void CorrelatorBankFixed::reset() {
   corr_im_.assign(l.codes, 0);
   p_.assign(l.codes, 0);
   q_.assign(l.codes, 0);
-  counter_ = {};
+  comb_re_.assign(l.codes, 0);
+  comb_im_.assign(l.codes, 0);
+  chip_acc_re_ = chip_acc_im_ = 0;
+  mix_events_ = chip_events_ = corr_events_ = {};
 }
 
 bool CorrelatorBankFixed::execute(std::int64_t y) {
@@ -343,8 +346,8 @@ std::size_t CorrelatorBankFixed::feed(std::span<const std::int64_t> in) {
   while (i < in.size()) {
     const std::int64_t y = in[i++];
     // 1. mixer: exact product, round half up into the mixer format.
-    mre = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(y * lo_cos[phase], mix_shift, mix_range_, counter_);
-    mim = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(-y * lo_sin[phase], mix_shift, mix_range_, counter_);
+    mre = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(y * lo_cos[phase], mix_shift, mix_range_, mix_events_);
+    mim = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(-y * lo_sin[phase], mix_shift, mix_range_, mix_events_);
     // 2. moving sum over one carrier cycle (exact; dec_bits hold it).
     acc_re += mre - b_re[phase];
     acc_im += mim - b_im[phase];
@@ -393,8 +396,10 @@ void CorrelatorBankFixed::decimated_output() {
     fim += taps[i] * bim[i];
   }
   if (++f_idx_ == f_n_) f_idx_ = 0;
-  const std::int64_t fq_re = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(fre, l.chip_shift, chip_range_, counter_);
-  const std::int64_t fq_im = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(fim, l.chip_shift, chip_range_, counter_);
+  const std::int64_t fq_re = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(fre, l.chip_shift, chip_range_, chip_events_);
+  const std::int64_t fq_im = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(fim, l.chip_shift, chip_range_, chip_events_);
+  chip_acc_re_ = fre;
+  chip_acc_im_ = fim;
   f_re_[f_idx_] = f_re_[f_idx_ + f_n_] = fq_re;
   f_im_[f_idx_] = f_im_[f_idx_ + f_n_] = fq_im;
 
@@ -423,8 +428,10 @@ void CorrelatorBankFixed::decimated_output() {
       cre += sg[c] * gr[c];
       cim += sg[c] * gi[c];
     }
-    corr_re_[j] = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(cre, l.corr_shift, corr_range_, counter_);
-    corr_im_[j] = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(cim, l.corr_shift, corr_range_, counter_);
+    comb_re_[j] = cre;
+    comb_im_[j] = cim;
+    corr_re_[j] = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(cre, l.corr_shift, corr_range_, corr_events_);
+    corr_im_[j] = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(cim, l.corr_shift, corr_range_, corr_events_);
     p_[j] = static_cast<std::uint64_t>(corr_re_[j] * corr_re_[j] + corr_im_[j] * corr_im_[j]);
     q_[j] = p_[j] * static_cast<std::uint64_t>(l.weights[j]);
   }

@@ -156,7 +156,20 @@ class CorrelatorBankFixed {
 
   const CorrelatorFixedLayout& layout() const { return layout_; }
   const CorrelatorFixedConfig& config() const { return cfg_; }
-  OverflowCounter overflow_events() const { return counter_; }
+  // Saturation events: all nodes, and per saturating node (mixer B, chip F_q, corr C_q).
+  OverflowCounter overflow_events() const {
+    return {mix_events_.saturations + chip_events_.saturations + corr_events_.saturations,
+            mix_events_.wraps + chip_events_.wraps + corr_events_.wraps};
+  }
+  OverflowCounter mix_overflow_events() const { return mix_events_; }
+  OverflowCounter chip_overflow_events() const { return chip_events_; }
+  OverflowCounter corr_overflow_events() const { return corr_events_; }
+  // Exact values before quantization of the last decimated output: the chip filter's
+  // accumulator F (fir_bits) and the combiner's C_j (comb_bits) of every code.
+  std::int64_t chip_acc_re() const { return chip_acc_re_; }
+  std::int64_t chip_acc_im() const { return chip_acc_im_; }
+  const std::vector<std::int64_t>& comb_re() const { return comb_re_; }
+  const std::vector<std::int64_t>& comb_im() const { return comb_im_; }
   int codes() const { return static_cast<int>(q_.size()); }
 
  private:
@@ -183,7 +196,9 @@ class CorrelatorBankFixed {
   std::uint64_t energy_ = 0;
   std::vector<std::int64_t> corr_re_, corr_im_;
   std::vector<std::uint64_t> p_, q_;
-  OverflowCounter counter_;
+  std::int64_t chip_acc_re_ = 0, chip_acc_im_ = 0;
+  std::vector<std::int64_t> comb_re_, comb_im_;
+  OverflowCounter mix_events_, chip_events_, corr_events_;
 };
 
 // The float front end (mixer + one-cycle moving sum + decimation by D) applied to a whole
