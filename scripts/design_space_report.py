@@ -38,7 +38,12 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
     refused = [p for p in pts if p["status"] != "ok"]
     default = next(p for p in pts if p["default"])
     axes = doc["spec"]["axes"]
-    cost = lambda p: p["cost"]["word_bits"]  # noqa: E731
+    cname = doc.get("cost_for_front", "word_bits")
+    clabel = "iCE40 LUT4 (yosys synth_ice40 -dsp)" if cname == "lut4" else "word_bits (sum of the configured word lengths)"
+    cshort = "LUT4" if cname == "lut4" else "word_bits"
+
+    def cost(p):
+        return p["cost"]["ice40"]["lut4"] if cname == "lut4" else p["cost"]["word_bits"]
     front = sorted((p for p in ok if p.get("pareto")), key=cost)
     front_e = sorted((p for p in ok if p.get("pareto_errors")), key=cost)
     d_rmse, d_err = rmse(default), default["accuracy"]["decode_errors"]
@@ -66,7 +71,7 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
         return up, ec
 
     out = {"sweep": sweep_path, "spec": doc["spec"], "points": len(pts), "evaluated": len(ok),
-           "refused": len(refused), "real_time_points": rt, "cost_for_front": "word_bits",
+           "refused": len(refused), "real_time_points": rt, "cost_for_front": cname,
            "default": default, "front": front, "front_errors": front_e,
            "default_on_front": bool(default.get("pareto")),
            "dominated_by": dominators[:3], "as_accurate_as_default": as_good[:10],
@@ -83,7 +88,7 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
             ax.scatter([cost(p) for p in sel], [metric(p) for p in sel], s=16, color=colour, alpha=0.6, label=fam)
         ax.plot([cost(p) for p in fr], [metric(p) for p in fr], "k-", lw=1, label="Pareto front")
         ax.scatter([cost(default)], [metric(default)], marker="*", s=160, color="red", label="default", zorder=5)
-        ax.set_xlabel("word_bits (sum of the configured word lengths)")
+        ax.set_xlabel(clabel)
         ax.set_ylabel(label)
         if label.startswith("distance"):
             ax.set_yscale("log")
@@ -103,61 +108,87 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
              f"(recorded with their error), {rt} of the evaluated keep real time.\n")
     L.append("Axes: " + "; ".join(f"`{x['key']}` {x['values']}" for x in axes) + ".\n")
     L.append("Reproduce (the points per hour below were measured with this command):\n")
-    L.append("```sh\nnice -n 10 build/tool/ranging sweep sweeps/design-space.yaml --out out/design-space --no-synth --jobs 2\n"
+    sweep_cmd = ("nice -n 10 build/tool/ranging sweep sweeps/design-space.yaml --out out/design-space "
+                 + ("--synth-targets " + ",".join(t for t in ("ice40", "ecp5", "xilinx") if default["cost"].get(t))
+                    if cname == "lut4" else "--no-synth") + " --jobs 2")
+    L.append("```sh\n" + sweep_cmd + "\n"
              "nice -n 10 build/tool/ranging wordlength sweeps/design-space-wordlength.yaml --out out/wordlength\n"
              "scripts/design_space_synth.sh out/synth default \"\" wordlength \"$(the joint result's KEY=VALUE list, "
              "table below)\" > out/synth.jsonl\n"
              "scripts/design_space_report.py out/design-space/sweep.json out/wordlength/wordlength.json "
              "out/synth.jsonl docs/results/design-space SECONDS\n```\n")
-    L.append("**Cost on the fronts is `word_bits`** (the sum of the configured word lengths), the sweep's proxy "
-             "without synthesis: this run used `--no-synth` (yosys at ~19 s CPU a point did not fit the shared "
-             "machine's session budget, see below). The iCE40/ECP5 figures are measured by yosys for the points in "
-             "the synthesis table only. Real time: the design's rule (model/hw/realtime.hpp).\n")
+    if cname == "lut4":
+        rtls = len({p["cost"]["ice40"].get("rtl_hash") for p in ok})
+        L.append("**Cost on the fronts is measured**: iCE40 LUT4 from yosys `synth_ice40 -dsp` of every evaluated "
+                 f"point's generated receiver top ({rtls} distinct RTLs, cached by hash), with SB_MAC16 and EBR beside "
+                 "it and the ECP5 LUT4 / MULT18 from `synth_ecp5` where the run asked for it. Real time: the design's "
+                 "rule (model/hw/realtime.hpp).\n")
+    else:
+        L.append("**Cost on the fronts is `word_bits`** (the sum of the configured word lengths), the sweep's proxy "
+                 "without synthesis (`--no-synth`). The iCE40/ECP5 figures are measured by yosys for the points in "
+                 "the synthesis table only. Real time: the design's rule (model/hw/realtime.hpp).\n")
     if seconds:
         L.append(f"Speed: {len(pts)} points in {seconds:.0f} s wall with `--jobs 2` on the shared 2-core machine: "
-                 f"**{len(pts) * 3600.0 / seconds:.0f} points per hour** without synthesis (with synthesis add "
-                 f"~19 s CPU per distinct RTL: at most ~190 points per hour per core).\n")
-    hdr = "| id | params | word_bits | errors (wrong/missed/false) | RMSE mm | max mm | clk/sample needed / avail | real time | stable |\n|---|---|---|---|---|---|---|---|---|"
+                 f"**{len(pts) * 3600.0 / seconds:.0f} points per hour** "
+                 + ("with synthesis (every distinct RTL through yosys for each target)" if cname == "lut4" else
+                    "without synthesis") + ".\n")
+    hdr = (f"| id | params | {cshort} | MAC16 | EBR | ECP5 LUT4 / MULT18 | word_bits | errors (wrong/missed/false) | RMSE mm | "
+           "max mm | clk/sample needed / avail | real time | stable |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 
     def row(p):
         q = p["accuracy"]
         r = "--" if q["distance_rmse_m"] is None else f"{q['distance_rmse_m'] * 1e3:.3f}"
         m = "--" if q["max_abs_error_m"] is None else f"{q['max_abs_error_m'] * 1e3:.3f}"
         st = p.get("stability", {}).get("stable")
-        return (f"| {p['id']} | {params(p)} | {cost(p)} | {q['decode_errors']} ({q['wrong_code']}/{q['missed']}/"
+        i = p["cost"].get("ice40") or {}
+        e = p["cost"].get("ecp5")
+        ec = f"{e['lut4']} / {e['mult18']}" if e else "--"
+        return (f"| {p['id']} | {params(p)} | {cost(p)} | {i.get('mac16', '--')} | {i.get('ebr', '--')} | {ec} | "
+                f"{p['cost']['word_bits']} | {q['decode_errors']} ({q['wrong_code']}/{q['missed']}/"
                 f"{q['false_alarms']}) | {r} | {m} | {p['cost']['clocks_per_sample_needed']:.2f} / "
                 f"{p['cost']['clocks_per_sample_available']} | {'yes' if p['cost']['real_time'] else 'NO'} | {st} |")
     L.append("## The default\n")
     L.append(hdr)
     L.append(row(default) + "\n")
     if default.get("pareto"):
-        L.append("The default is **on** the (word_bits, RMSE) front.\n")
+        L.append(f"The default is **on** the ({cshort}, RMSE) front.\n")
     elif dominators:
         b = dominators[0]
-        L.append(f"The default is **not** on the (word_bits, RMSE) front: {len(dominators)} Gold4 points dominate it; "
+        L.append(f"The default is **not** on the ({cshort}, RMSE) front: {len(dominators)} Gold4 points dominate it; "
                  f"the most accurate, {b['id']} ({params(b)}), has RMSE {rmse(b) * 1e3:.3f} mm vs "
-                 f"{d_rmse * 1e3:.3f} mm ({(1 - rmse(b) / d_rmse) * 100:.0f} % lower) at word_bits {cost(b)} vs "
+                 f"{d_rmse * 1e3:.3f} mm ({(1 - rmse(b) / d_rmse) * 100:.0f} % lower) at {cshort} {cost(b)} vs "
                  f"{cost(default)}, {b['accuracy']['decode_errors']} decode errors vs {d_err}, real time: "
                  f"{'yes' if b['cost']['real_time'] else 'NO'}.\n")
-    L.append("## Pareto front (word_bits, RMSE)\n")
+    L.append(f"## Pareto front ({cshort}, RMSE)\n")
     L.append(hdr)
     L += [row(p) for p in front]
-    L.append("\n## Pareto front (word_bits, decode errors)\n")
+    L.append(f"\n## Pareto front ({cshort}, decode errors)\n")
     L.append(hdr)
     L += [row(p) for p in front_e]
     L.append(f"\n## Gold4 designs as accurate as the default (0 decode errors beyond the default's {d_err}, RMSE <= "
              f"{tol * 1e3:.3f} mm = 1.1 x), real time, cheapest first\n")
     L.append(hdr)
     L += [row(p) for p in as_good[:10]]
-    L.append("\n## Synthesis of chosen points (yosys synth_ice40 -dsp and synth_ecp5 of receiver_top)\n")
-    L.append("| point | overrides | iCE40 LUT4 | DFF | carry | SB_MAC16 | EBR | channels on UP5K | ECP5 LUT4 | FF | MULT18 | EBR | channels on ECP5-25F |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    if cname == "lut4" and as_good:
+        b = as_good[0]
+        up, ec = channels(b["cost"])
+        i = b["cost"]["ice40"]
+        L.append(f"\n**Smallest swept UP5K design with the default's accuracy**: {b['id']} ({params(b)}): {i['lut4']} LUT4, "
+                 f"{i['mac16']} SB_MAC16, {i['ebr']} EBR against the default's {default['cost']['ice40']['lut4']} / "
+                 f"{default['cost']['ice40']['mac16']} / {default['cost']['ice40']['ebr']}; {up} receive channel(s) on "
+                 f"the UP5K" + (f", {ec} on an ECP5-25F" if ec is not None else "") + ".")
+    L.append("\n## Synthesis of chosen points (yosys synth_ice40 -dsp, synth_ecp5 and synth_xilinx -family xc7 of receiver_top)\n")
+    L.append("| point | overrides | iCE40 LUT4 | DFF | carry | SB_MAC16 | EBR | channels on UP5K | ECP5 LUT4 | FF | MULT18 | EBR | "
+             "channels on ECP5-25F | Xilinx-7 LUT | FF | DSP48E1 | RAMB18 / 36 |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for s in out["synthesis"]:
         i, e, c = s["ice40"], s.get("ecp5") or {}, s["channels"]
         e = {k: e.get(k, "--") for k in ("lut4", "ff", "mult18", "ebr")}
+        x = s.get("xilinx") or {}
+        x = {k: x.get(k, "--") for k in ("lut", "ff", "dsp48", "ramb18", "ramb36")}
         c = {"up5k": c["up5k"], "ecp5_25f": "--" if c["ecp5_25f"] is None else c["ecp5_25f"]}
         L.append(f"| {s['name']} | {' '.join(s['set']) or '(default)'} | {i['lut4']} | {i['dff']} | {i['carry']} | "
                  f"{i['mac16']} | {i['ebr']} | {c['up5k']} | {e['lut4']} | {e['ff']} | {e['mult18']} | {e['ebr']} | "
-                 f"{c['ecp5_25f']} |")
+                 f"{c['ecp5_25f']} | {x['lut']} | {x['ff']} | {x['dsp48']} | {x['ramb18']} / {x['ramb36']} |")
     L.append("\nChannels = min over LUT4 / 5280 logic cells, SB_MAC16 / 8, EBR / 30 (UP5K) and LUT4 / 24288, "
              "MULT18 / 28, EBR / 56 (ECP5-25F), receiver only (the system around it, UART and transmitter, not "
              "counted; LUT4 is a lower bound on logic cells). The paper's system has four pairs.\n")
@@ -196,8 +227,13 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
     L.append("- `hardware.clock_hz` is the clocks-per-sample axis: the bandpass shares its multipliers over "
              "clock_hz / fs clocks (SAMPLE_CYCLES), and 20 MHz (4 clocks) is below the 6 the bandpass needs: "
              "such points are evaluated (the model is clock-free) but marked NOT real time.")
-    L.append("- `word_bits` ignores the structure (taps, sections, sharing): the synthesis table is the measured cost for the "
-             "points it holds.")
+    if cname != "lut4":
+        L.append("- `word_bits` ignores the structure (taps, sections, sharing): the synthesis table is the measured cost "
+                 "for the points it holds.")
+    else:
+        L.append("- LUT4 is yosys's count before place and route (nextpnr packs LUT4 and DFF into logic cells; the "
+                 "bitstream of the default has 4328 LUT4 with the system around the receiver, docs/bitstream.md). "
+                 "`--place` is not in this run.")
     L.append("- M1 (7 codes of 7 chips, m-sequence shifts) and Gold4 (9 Gold codes of 7 chips) are different code sets; the default "
              "(Gold4) is compared with Gold4 points only.")
     L.append("- 40 MHz points are receivers only: the system top refuses 40 MHz (clk_hz / baud = 26.67 for its "

@@ -203,6 +203,15 @@ TEST_F(Sweep, BadSpecsExitTwoNamingFileLineAndKeyAndWriteNothing) {
   EXPECT_EQ(shard.status, 2);
   EXPECT_NE(shard.err.find("--shard"), std::string::npos) << shard.err;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
+  for (const char* targets : {"ice40,vivado", "ecp5,ecp5", ""}) {
+    const auto t = run_tool("sweep " + spec("ok", grid_axes()).string() + " --out " + (dir_ / "out").string() +
+                            " --synth-targets '" + targets + "' --no-plot");
+    SCOPED_TRACE(targets);
+    EXPECT_EQ(t.status, 2);
+    EXPECT_TRUE(t.out.empty()) << t.out;
+    EXPECT_NE(t.err.find("option --synth-targets"), std::string::npos) << t.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out"));
+  }
 }
 
 // The recipe of docs/design-space.md: GNU parallel runs the shards, `sweep merge` joins them.

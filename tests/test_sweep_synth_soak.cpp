@@ -42,3 +42,30 @@ TEST(SweepSynth, EqualRtlIsSynthesizedOnceAndResourcesAreReported) {
   EXPECT_EQ(doc["cost_for_front"], "lut4");
   fs::remove_all(dir);
 }
+
+TEST(SweepSynth, EcpAndXilinxEstimatesBesideTheIce40s) {
+  const fs::path dir = fs::temp_directory_path() / ("ranging_sweep_targets_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.yaml") << "transducers: {}\ngeometry:\n  distances_m: [0.5]\nexcitation:\n  family: Gold4\n"
+                                       "  codes: [2]\nnoise:\n  noise_v: 0.01\n";
+  std::ofstream(dir / "spec.yaml") << "name: targets\nconfig: " << RANGING_SOURCE_DIR
+                                   << "/configs/default.yaml\nscene: scene.yaml\nmode: grid\naxes:\n"
+                                      "  - key: scene.noise.noise_v\n    values: [0.02]\n";
+  const auto r = run_tool("sweep " + (dir / "spec.yaml").string() + " --out " + (dir / "out").string() +
+                          " --synth-targets ice40,ecp5,xilinx --jobs 2 --no-plot --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json doc = json::parse(std::ifstream(dir / "out/sweep.json"));
+  const json& c = doc["points"][0]["cost"];
+  EXPECT_GT(c["ecp5"]["lut4"].get<int>(), 1000) << c.dump();
+  EXPECT_GT(c["ecp5"]["mult18"].get<int>(), 0);
+  EXPECT_GT(c["xilinx"]["lut"].get<int>(), 1000);
+  EXPECT_GT(c["xilinx"]["dsp48"].get<int>(), 0);
+  EXPECT_EQ(doc["points"][1]["cost"]["xilinx"], c["xilinx"]) << "same RTL: one synthesis per target";
+  std::ifstream csv(dir / "out/points.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find("ecp5_mult18"), std::string::npos) << header;
+  EXPECT_NE(header.find("xilinx_dsp48"), std::string::npos) << header;
+  fs::remove_all(dir);
+}

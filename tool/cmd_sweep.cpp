@@ -1,5 +1,6 @@
 // `ranging sweep SPEC.yaml --out DIR` and `ranging sweep merge --out DIR SHARD_DIR...`: design-space
 // sweeps (model/study/sweep.hpp, docs/design-space.md).
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
@@ -156,7 +157,9 @@ int cmd_sweep(const Args& args) {
   p.option("--shard", "I/N", "evaluate only the points of shard I of N (a stable hash of their parameters)");
   p.option("--cache", "DIR", "synthesis cache folder, may be shared by shards (default: DIR/cache)");
   p.flag("--dry-run", "check the spec, print the ids and parameters of the points (of the shard) and exit; writes nothing");
-  p.flag("--no-synth", "skip yosys synth_ice40 (cost: the throughput rule and the word-length proxy only)");
+  p.flag("--no-synth", "skip yosys synthesis (cost: the throughput rule and the word-length proxy only)");
+  p.option("--synth-targets", "LIST", "comma-separated yosys targets per point: ice40 (synth_ice40 -dsp), ecp5 "
+           "(synth_ecp5), xilinx (synth_xilinx -family xc7); the fronts use ice40's LUT4 when it is in the list", "ice40");
   p.flag("--no-plot", "skip DIR/front.png (no Python needed)");
   p.flag("--quiet", "no progress on stderr");
   if (!p.parse(args)) return 0;
@@ -177,6 +180,26 @@ int cmd_sweep(const Args& args) {
     }
     if (shard_n < 1 || shard_i < 0 || shard_i >= shard_n) {
       throw InputError("option --shard: " + s + ": valid range is 0 <= I < N, N >= 1");
+    }
+  }
+  std::vector<std::string> targets;
+  {
+    const std::string list = p.get_or("--synth-targets", "ice40");
+    const auto valid = study::synth_target_names();
+    std::string joined;
+    for (const auto& v : valid) joined += (joined.empty() ? "" : ", ") + v;
+    std::size_t a = 0;
+    while (a <= list.size()) {
+      const std::size_t b = std::min(list.find(',', a), list.size());
+      const std::string t = list.substr(a, b - a);
+      if (std::find(valid.begin(), valid.end(), t) == valid.end()) {
+        throw InputError("option --synth-targets: '" + t + "': valid targets are " + joined);
+      }
+      if (std::find(targets.begin(), targets.end(), t) != targets.end()) {
+        throw InputError("option --synth-targets: '" + t + "' is listed twice");
+      }
+      targets.push_back(t);
+      a = b + 1;
     }
   }
   const SweepSpec spec = study::load_sweep_spec(p.positionals().at(0));  // bad specs: nothing written
@@ -211,6 +234,7 @@ int cmd_sweep(const Args& args) {
 
   study::PointOptions opt;
   opt.synth = !p.has("--no-synth");
+  opt.targets = targets;
   opt.cache_dir = fs::absolute(cache).string();
   opt.source_dir = source_dir();
   std::map<std::string, json> results;
@@ -220,8 +244,18 @@ int cmd_sweep(const Args& args) {
     if (fs::exists(f)) {
       try {
         json j = json::parse(slurp(f));
-        // A point done before is kept when it was evaluated with the same synthesis setting.
-        if (j.at("id") == pt.id && (j.at("status") != "ok" || j["cost"].contains("ice40") == opt.synth)) {
+        // A point done before is kept when it was evaluated with the same synthesis setting
+        // (every requested target present; none without synthesis).
+        bool same = j.at("status") != "ok";
+        if (!same) {
+          same = true;
+          for (const auto& t : study::synth_target_names()) {
+            const bool want = opt.synth && std::find(targets.begin(), targets.end(), t) != targets.end();
+            if (want && !j["cost"].contains(t)) same = false;
+            if (!opt.synth && j["cost"].contains(t)) same = false;
+          }
+        }
+        if (j.at("id") == pt.id && same) {
           results[pt.id] = j;
           continue;
         }

@@ -254,28 +254,66 @@ json jnum(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 std::mutex synth_mutex;
 std::map<std::string, std::shared_ptr<std::mutex>> synth_locks;
 
-// iCE40 resources of the generated receiver top (yosys synth_ice40 -dsp), cached by the hash of
-// the generated RTL and the module sources.
-json synthesize(const std::map<std::string, std::string>& files, const PointOptions& o) {
+// One synthesis target: the yosys script and how its cells are counted.
+struct SynthTarget {
+  const char* name;
+  const char* script;  // after the reads and hierarchy
+  // cell name prefix -> cost field (summed)
+  std::vector<std::pair<std::string, std::string>> cells;
+  std::vector<std::string> fields;
+};
+const std::vector<SynthTarget>& synth_targets() {
+  static const std::vector<SynthTarget> t = {
+      {"ice40", "synth_ice40 -dsp -top receiver_top",
+       {{"SB_LUT4", "lut4"}, {"SB_DFF", "dff"}, {"SB_CARRY", "carry"}, {"SB_MAC16", "mac16"}, {"SB_RAM40", "ebr"}},
+       {"lut4", "dff", "carry", "mac16", "ebr"}},
+      {"ecp5", "synth_ecp5 -top receiver_top",
+       {{"LUT4", "lut4"}, {"TRELLIS_FF", "ff"}, {"CCU2C", "ccu2c"}, {"MULT18X18D", "mult18"}, {"DP16KD", "ebr"},
+        {"PDPW16KD", "ebr"}, {"TRELLIS_DPR16X4", "lutram"}},
+       {"lut4", "ff", "ccu2c", "mult18", "ebr", "lutram"}},
+      {"xilinx", "synth_xilinx -family xc7 -top receiver_top",
+       {{"LUT", "lut"}, {"FD", "ff"}, {"CARRY4", "carry4"}, {"DSP48E1", "dsp48"}, {"RAMB18E1", "ramb18"},
+        {"RAMB36E1", "ramb36"}, {"RAM", "lutram"}, {"SRL", "srl"}},
+       {"lut", "ff", "carry4", "dsp48", "ramb18", "ramb36", "lutram", "srl"}},
+  };
+  return t;
+}
+
+}  // namespace
+
+std::vector<std::string> synth_target_names() {
+  std::vector<std::string> n;
+  for (const auto& t : synth_targets()) n.emplace_back(t.name);
+  return n;
+}
+
+namespace {
+
+// Resources of the generated receiver top for one target (yosys), cached by the hash of the
+// generated RTL, the module sources and the target's script.
+json synthesize(const std::map<std::string, std::string>& files, const PointOptions& o, const SynthTarget& target) {
   const std::vector<std::string> modules = {"bandpass_sos.v", "correlator_bank.v", "peak_detector.v"};
   std::string all = files.at("rtl/receiver_top.v");
   for (const auto& m : modules) all += slurp(o.source_dir + "/rtl/" + m);
+  // iCE40 keeps the hash of earlier sweeps (their caches stay valid); other targets add their script.
+  if (std::string(target.name) != "ice40") all += target.script;
   const std::string hash = hex16(fnv1a(all));
+  const std::string key = std::string(target.name) == "ice40" ? hash : hash + "." + target.name;
   std::shared_ptr<std::mutex> lock;
   {
     std::lock_guard<std::mutex> g(synth_mutex);
-    auto& l = synth_locks[hash];
+    auto& l = synth_locks[key];
     if (!l) l = std::make_shared<std::mutex>();
     lock = l;
   }
   std::lock_guard<std::mutex> g(*lock);
-  const std::string cached = o.cache_dir + "/" + hash + ".json";
+  const std::string cached = o.cache_dir + "/" + key + ".json";
   if (fs::exists(cached)) {
     json j = json::parse(slurp(cached));
     j["cached"] = true;
     return j;
   }
-  const std::string work = o.cache_dir + "/" + hash + ".work";
+  const std::string work = o.cache_dir + "/" + key + ".work";
   fs::remove_all(work);
   fs::create_directories(work);
   for (const auto& [name, text] : files) {
@@ -284,11 +322,14 @@ json synthesize(const std::map<std::string, std::string>& files, const PointOpti
   }
   std::string cmd = "cd '" + work + "' && nice yosys -q -l yosys.log -p '";
   for (const auto& m : modules) cmd += "read_verilog -defer " + o.source_dir + "/rtl/" + m + "; ";
-  cmd += "read_verilog -defer -I. receiver_top.v; hierarchy -top receiver_top; synth_ice40 -dsp -top receiver_top; "
-         "tee -q -o stat.txt stat' > /dev/null 2>&1";
+  cmd += "read_verilog -defer -I. receiver_top.v; hierarchy -top receiver_top; " + std::string(target.script) +
+         "; tee -q -o stat.txt stat' > /dev/null 2>&1";
   const auto t0 = std::chrono::steady_clock::now();
-  if (std::system(cmd.c_str()) != 0) return json{{"synth_error", "yosys failed: see " + work + "/yosys.log"}};
-  json j{{"rtl_hash", hash}, {"lut4", 0}, {"dff", 0}, {"carry", 0}, {"mac16", 0}, {"ebr", 0}};
+  if (std::system(cmd.c_str()) != 0) {
+    return json{{"synth_error", std::string("yosys (") + target.name + ") failed: see " + work + "/yosys.log"}};
+  }
+  json j{{"rtl_hash", hash}};
+  for (const auto& f : target.fields) j[f] = 0;
   std::istringstream stat(slurp(work + "/stat.txt"));
   std::string line;
   while (std::getline(stat, line)) {
@@ -296,11 +337,12 @@ json synthesize(const std::map<std::string, std::string>& files, const PointOpti
     std::string cell;
     long long n = 0;
     if (!(ls >> cell >> n)) continue;
-    if (cell == "SB_LUT4") j["lut4"] = j["lut4"].get<long long>() + n;
-    else if (cell.rfind("SB_DFF", 0) == 0) j["dff"] = j["dff"].get<long long>() + n;
-    else if (cell == "SB_CARRY") j["carry"] = j["carry"].get<long long>() + n;
-    else if (cell == "SB_MAC16") j["mac16"] = j["mac16"].get<long long>() + n;
-    else if (cell.rfind("SB_RAM40", 0) == 0) j["ebr"] = j["ebr"].get<long long>() + n;
+    for (const auto& [prefix, field] : target.cells) {
+      if (cell.rfind(prefix, 0) == 0) {
+        j[field] = j[field].get<long long>() + n;
+        break;
+      }
+    }
   }
   j["synth_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_file_atomic(cached, j.dump(2) + "\n");
@@ -404,10 +446,13 @@ json evaluate_point(const SweepSpec& spec, const PointDef& point, const PointOpt
     cost["word_bits"] = word_bits(scene.receiver.config);
     if (options.synth) {
       const auto files = generate_hardware_files(design, "sweep " + spec.name);
-      json syn = synthesize(files, options);
-      syn.erase("cached");
-      syn.erase("synth_seconds");
-      cost["ice40"] = syn;
+      for (const auto& t : synth_targets()) {
+        if (std::find(options.targets.begin(), options.targets.end(), t.name) == options.targets.end()) continue;
+        json syn = synthesize(files, options, t);
+        syn.erase("cached");
+        syn.erase("synth_seconds");
+        cost[t.name] = syn;
+      }
     }
     out["cost"] = cost;
     // The stability guard's verdict (model/dsp/stability.hpp); a design it refuses never gets
@@ -516,13 +561,22 @@ std::string points_csv(const std::vector<json>& points) {
   const std::vector<std::string> cost = {"clocks_per_sample_needed", "clocks_per_sample_available",
                                          "bank_back_end_clocks_per_group", "detector_clocks_per_group",
                                          "group_clocks", "real_time", "word_bits"};
-  const std::vector<std::string> ice = {"lut4", "dff", "carry", "mac16", "ebr"};
+  // Synthesis columns: every field of every target some point was synthesized for.
+  std::vector<std::pair<std::string, std::string>> syn_cols;
+  for (const auto& t : synth_targets()) {
+    const bool any = std::any_of(points.begin(), points.end(), [&](const json& p) {
+      return p.at("status") == "ok" && p["cost"].contains(t.name);
+    });
+    if (any || std::string(t.name) == "ice40") {
+      for (const auto& f : t.fields) syn_cols.emplace_back(t.name, f);
+    }
+  }
   std::ostringstream os;
   os << "id,default,status";
   for (const auto& k : keys) os << "," << k;
   for (const auto& k : acc) os << "," << k;
   for (const auto& k : cost) os << "," << k;
-  for (const auto& k : ice) os << ",ice40_" << k;
+  for (const auto& [t, k] : syn_cols) os << "," << t << "_" << k;
   os << ",stable,max_pole_radius,pareto,pareto_errors,error\n";
   for (const auto& p : points) {
     os << p.at("id").get<std::string>() << "," << cell(p.at("default")) << "," << p.at("status").get<std::string>();
@@ -530,8 +584,8 @@ std::string points_csv(const std::vector<json>& points) {
     const bool ok = p.at("status") == "ok";
     for (const auto& k : acc) os << "," << (ok ? cell(p["accuracy"][k]) : "");
     for (const auto& k : cost) os << "," << (ok ? cell(p["cost"][k]) : "");
-    for (const auto& k : ice) {
-      os << "," << (ok && p["cost"].contains("ice40") && p["cost"]["ice40"].contains(k) ? cell(p["cost"]["ice40"][k]) : "");
+    for (const auto& [t, k] : syn_cols) {
+      os << "," << (ok && p["cost"].contains(t) && p["cost"][t].contains(k) ? cell(p["cost"][t][k]) : "");
     }
     const bool has_stab = ok && p.contains("stability");
     os << "," << (has_stab ? cell(p["stability"]["stable"]) : "") << ","

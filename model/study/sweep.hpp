@@ -57,9 +57,15 @@ bool in_shard(const PointDef& p, int i, int n);
 
 struct PointOptions {
   bool synth = true;
+  // Synthesis targets (synth_target_names()): ice40 (synth_ice40 -dsp: LUT4, DFF, carry,
+  // SB_MAC16, EBR), ecp5 (synth_ecp5: LUT4, FF, CCU2C, MULT18, EBR), xilinx (synth_xilinx
+  // -family xc7: LUT, FF, CARRY4, DSP48E1, RAMB18/36). The fronts use ice40's LUT4 when present.
+  std::vector<std::string> targets = {"ice40"};
   std::string cache_dir;    // synthesis results by RTL hash
   std::string source_dir;   // the project (rtl/*.v)
 };
+
+std::vector<std::string> synth_target_names();
 
 // {"id", "params", "default", "status": "ok" | "refused", "error", "accuracy", "cost", "speed"}.
 // A configuration the model refuses is "refused" with its error, not an exception.
