@@ -149,3 +149,32 @@ TEST(SimulateRtl, SceneEventsThroughTheRtlEqualTheFixedModels) {
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("--rtl"), std::string::npos) << bad.err;
 }
+
+// The same scene through the iCE40 gate-level netlist (yosys synth_ice40 -dsp, Verilated with
+// yosys' cell models): the post-synthesis rung of the fidelity ladder, events identical too.
+TEST(SimulateRtl, SceneEventsThroughThePostSynthesisNetlistEqualTheFixedModels) {
+  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
+  const auto fixed = run_tool("simulate " + scene + " --precision fixed --quiet --out " + (scratch() / "fixed-ps").string());
+  ASSERT_EQ(fixed.status, 0) << fixed.err;
+  const auto r = run_tool("simulate " + scene + " --precision rtl --rtl-simulator postsynth --json --quiet --out " +
+                          (scratch() / "postsynth").string());
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["rtl"]["simulator"], "postsynth");
+  EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
+  EXPECT_EQ(j["rtl"]["mismatches"], 0);
+  EXPECT_GT(j["rtl"]["streams"].get<int>(), 0);
+  auto read = [](const fs::path& p) {
+    std::stringstream ss;
+    ss << std::ifstream(p).rdbuf();
+    return ss.str();
+  };
+  EXPECT_EQ(read(scratch() / "postsynth/measurements.csv"), read(scratch() / "fixed-ps/measurements.csv"));
+  for (const std::string bad : {" --precision rtl --rtl-simulator icarus", " --precision fixed --rtl-simulator postsynth"}) {
+    const auto b = run_tool("simulate " + scene + bad + " --out " + (scratch() / "bad-ps").string());
+    EXPECT_EQ(b.status, 2) << bad;
+    EXPECT_TRUE(b.out.empty()) << b.out;
+    EXPECT_NE(b.err.find("--rtl-simulator"), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(scratch() / "bad-ps"));
+  }
+}

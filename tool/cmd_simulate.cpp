@@ -242,6 +242,9 @@ int cmd_simulate(const Args& args) {
            "stream also through the Verilated receiver (built at run time), whose events must be identical");
   p.flag("--check-rtl", "the same as --precision rtl");
   p.option("--rtl", "DIR", "with --precision rtl: the RTL sources (default: the project's rtl/)");
+  p.option("--rtl-simulator", "verilator|postsynth",
+           "with --precision rtl: what runs the streams: verilator (the RTL) or postsynth (the iCE40\n"
+           "gate-level netlist of yosys synth_ice40 -dsp, Verilated with yosys' cell models)", "verilator");
   p.option("--out", "DIR", "output directory (created); default out/<scene name>");
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
@@ -265,6 +268,11 @@ int cmd_simulate(const Args& args) {
                      scene.receiver.precision);
   }
   if (p.has("--rtl") && !rtl) throw InputError("option --rtl: only with --precision rtl or --check-rtl");
+  const std::string rtl_sim = p.get_or("--rtl-simulator", "verilator");
+  if (rtl_sim != "verilator" && rtl_sim != "postsynth") {
+    throw InputError("option --rtl-simulator: '" + rtl_sim + "' is not valid; valid: verilator, postsynth");
+  }
+  if (p.has("--rtl-simulator") && !rtl) throw InputError("option --rtl-simulator: only with --precision rtl or --check-rtl");
   if (rtl) scene.receiver.precision = "fixed";
   const std::string out = p.get_or("--out", "out/" + scene.name);
   const bool json = p.has("--json");
@@ -278,7 +286,7 @@ int cmd_simulate(const Args& args) {
   OutputDir out_dir(out, "option --out");  // checked before any work; removed again if the run fails
   SceneSimulator sim(scene);
   sim.set_jobs(jobs);
-  RtlSceneCheck rtl_check(p.get_or("--rtl", ""), "", p.has("--quiet"));
+  RtlSceneCheck rtl_check(p.get_or("--rtl", ""), "", p.has("--quiet"), rtl_sim);
   if (rtl) rtl_check.attach(sim);
   // stdout is written only once the run has succeeded: a failing command prints nothing there.
   std::ostringstream text;
@@ -312,6 +320,7 @@ int cmd_simulate(const Args& args) {
   if (rtl) {
     summary["precision"] = "rtl";
     summary["rtl"] = rtl_check.run();
+    summary["rtl"]["simulator"] = rtl_sim;
   }
   if (p.has("--plot")) plot_with_script("option --plot", "scripts/plot_simulate_error.py", error_plot_data(scene, run), *p.get("--plot"));
   write_file_atomic(out + "/measurements.csv", measurements_csv(run, scene.speed()));
@@ -368,7 +377,8 @@ int cmd_simulate(const Args& args) {
     }
     if (rtl) {
       const auto& r = summary["rtl"];
-      text << "\nRTL (Verilated receiver_top): " << r["streams"] << " streams, " << r["events_compared"]
+      text << "\nRTL (" << (rtl_sim == "postsynth" ? "Verilated iCE40 gate-level netlist" : "Verilated receiver_top")
+           << "): " << r["streams"] << " streams, " << r["events_compared"]
            << " events compared with the fixed model, " << r["mismatches"] << " mismatches"
            << (r["pass"].get<bool>() ? ": identical\n" : "\n");
       if (!r["first_mismatch"].is_null()) text << "first mismatch: " << r["first_mismatch"].dump() << "\n";

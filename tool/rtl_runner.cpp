@@ -136,15 +136,52 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
   if (shell("command -v verilator >/dev/null 2>&1") != 0) {
     throw InputError("verilator is not installed (Debian: apt-get install verilator)");
   }
-  const fs::path obj = work / "obj";
+  if (opt_.simulator != "verilator" && opt_.simulator != "postsynth") {
+    throw InputError("simulator '" + opt_.simulator + "': valid are verilator, postsynth");
+  }
+  const bool gates = opt_.simulator == "postsynth";
+  const fs::path obj = work / (gates ? "obj-postsynth" : "obj");
   driver_ = obj / "verify_driver";
+  std::string sources = "-f files.f";
+  std::string netlist_cmd;
+  if (gates) {
+    // The netlist as scripts/build_bitstream.sh synthesizes it; yosys' iCE40 cell models.
+    if (shell("command -v yosys >/dev/null 2>&1") != 0) {
+      throw InputError("yosys is not installed (Debian: apt-get install yosys)");
+    }
+    // yosys' data folder (cells_sim.v) next to its binary: BIN/../share/yosys (yosys-config is
+    // in yosys-dev, which the flow does not need).
+    std::string datdir;
+    {
+      const char* path = std::getenv("PATH");
+      std::istringstream dirs(path ? path : "/usr/bin");
+      for (std::string d; std::getline(dirs, d, ':');) {
+        if (!d.empty() && fs::exists(fs::path(d) / "yosys")) {
+          const fs::path share = fs::weakly_canonical(fs::path(d) / "yosys").parent_path().parent_path() / "share/yosys";
+          if (fs::exists(share / "ice40/cells_sim.v")) datdir = share.string();
+          break;
+        }
+      }
+    }
+    if (datdir.empty()) throw InputError("cannot find yosys' ice40/cells_sim.v (BIN/../share/yosys next to yosys)");
+    std::string reads;
+    std::istringstream fl(read(work / "ip/files.f"));
+    for (std::string line; std::getline(fl, line);) {
+      if (!line.empty()) reads += "read_verilog -defer -I. " + line + "; ";
+    }
+    netlist_cmd = "cd " + quote((work / "ip").string()) + " && yosys -q -l ../postsynth-yosys.log -p '" + reads +
+                  "hierarchy -top receiver_top; synth_ice40 -dsp -top receiver_top; write_verilog -noattr "
+                  "../receiver_top_syn.v' > /dev/null 2>&1";
+    sources = "-DNO_ICE40_DEFAULT_ASSIGNMENTS ../receiver_top_syn.v " + quote(datdir + "/ice40/cells_sim.v");
+  }
   const std::string cmd = "cd " + quote((work / "ip").string()) +
-                          " && verilator --cc --exe --build -j 2 -Wno-fatal -Wno-lint -Wno-style"
+                          " && verilator --cc --exe --build -j 2 -Wno-fatal -Wno-lint -Wno-style" +
+                          std::string(gates ? " --no-timing" : "") +
                           " --x-assign unique --x-initial unique -O3 -CFLAGS -O1" +
-                          std::string(opt_.trace ? " --trace-fst" : "") +
-                          " -f files.f --top-module receiver_top --Mdir " + quote(obj.string()) +
+                          std::string(opt_.trace ? " --trace-fst" : "") + " " + sources +
+                          " --top-module receiver_top --Mdir " + quote(obj.string()) +
                           " -o verify_driver " + quote(driver_src.string());
-  std::uint64_t key = fnv1a(cmd + read(driver_src));
+  std::uint64_t key = fnv1a(netlist_cmd + cmd + read(driver_src));
   for (const char* h : {"tb/verilator_harness.hpp", "tb/bits.hpp"}) key = fnv1a(read(fs::path(src) / h), key);
   std::istringstream list(read(work / "ip/files.f"));
   for (std::string line; std::getline(list, line);) key = fnv1a(read(work / "ip" / line), key);
@@ -153,12 +190,14 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
   if (fs::exists(driver_) && read(stamp_file) == stamp) return;
   const fs::path log = work / "build.log";
   if (!opt_.quiet) {
-    std::cerr << "building the Verilated receiver_top of '" << design.config.name << "' in " << work.string()
-              << " (verilator --build: about 1-2 minutes) ..." << std::flush;
+    std::cerr << "building the Verilated " << (gates ? "post-synthesis netlist" : "receiver_top") << " of '"
+              << design.config.name << "' in " << work.string()
+              << (gates ? " (yosys synth_ice40 and verilator --build: a few minutes) ..."
+                        : " (verilator --build: about 1-2 minutes) ...") << std::flush;
   }
   const auto t0 = std::chrono::steady_clock::now();
   fs::remove(stamp_file, ec);
-  const int rc = shell(cmd + " > " + quote(log.string()) + " 2>&1");
+  const int rc = shell((netlist_cmd.empty() ? "" : "(" + netlist_cmd + ") && ") + cmd + " > " + quote(log.string()) + " 2>&1");
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!opt_.quiet) std::cerr << (rc == 0 ? " done" : " failed") << " in " << static_cast<int>(build_seconds_) << " s\n";
   if (rc != 0 || !fs::exists(driver_)) {

@@ -2,7 +2,8 @@
 // The Verilated receiver of any configuration, built at run time (`ranging verify`, and the
 // RTL precision of `ranging simulate`): the IP folder is generated into a work folder (never
 // the source tree), tb/verify_driver.cpp is compiled against it with `verilator --build`
-// (cached: the same sources are not rebuilt), and sample streams are run through it. The
+// (cached: the same sources are not rebuilt), and sample streams are run through it. With
+// simulator "postsynth" the same driver runs the iCE40 gate-level netlist of the IP folder. The
 // driver writes raw port values; this module decodes them with the configuration's widths.
 #include <cstdint>
 #include <filesystem>
@@ -20,6 +21,9 @@ struct RtlBuildOptions {
   std::filesystem::path work_dir;    // ip/, obj/, runs/ go here
   std::string origin;        // configuration name for the generated banners
   bool trace = false;        // compile FST tracing in (RANGING_TRACE=1 switches it on)
+  // What is Verilated: "verilator" the RTL; "postsynth" the gate-level netlist of yosys
+  // synth_ice40 -dsp (as the bitstream flow synthesizes it; SB_* cells from yosys' cells_sim.v).
+  std::string simulator = "verilator";
   bool quiet = false;        // no progress on stderr
 };
 

@@ -12,8 +12,8 @@ struct RtlSceneCheck::Group {
   std::vector<std::vector<EventFixed>> expected;
 };
 
-RtlSceneCheck::RtlSceneCheck(std::string rtl_dir, std::string work_root, bool quiet)
-    : rtl_dir_(std::move(rtl_dir)), work_root_(std::move(work_root)), quiet_(quiet) {}
+RtlSceneCheck::RtlSceneCheck(std::string rtl_dir, std::string work_root, bool quiet, std::string simulator)
+    : rtl_dir_(std::move(rtl_dir)), work_root_(std::move(work_root)), simulator_(std::move(simulator)), quiet_(quiet) {}
 
 RtlSceneCheck::~RtlSceneCheck() = default;
 
@@ -52,6 +52,7 @@ nlohmann::json RtlSceneCheck::run() {
     o.work_dir = work_root_.empty() ? default_work_dir("simulate", name) : std::filesystem::path(work_root_) / name;
     o.origin = "scene receiver " + name;
     o.quiet = quiet_;
+    o.simulator = simulator_;
     const RtlReceiver rtl(g->design, o);
     if (!quiet_) std::cerr << "running " << g->streams.size() << " streams of " << name << " through the RTL ...\n";
     const auto results = rtl.run(g->streams);

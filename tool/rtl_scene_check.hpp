@@ -15,7 +15,8 @@ namespace ranging::tool {
 
 class RtlSceneCheck {
  public:
-  RtlSceneCheck(std::string rtl_dir, std::string work_root, bool quiet);
+  // simulator: RtlBuildOptions::simulator (verilator: the RTL; postsynth: the iCE40 netlist).
+  RtlSceneCheck(std::string rtl_dir, std::string work_root, bool quiet, std::string simulator = "verilator");
   ~RtlSceneCheck();
   // Installs the collector on the simulator (before the scene runs).
   void attach(SceneSimulator& sim);
@@ -25,7 +26,7 @@ class RtlSceneCheck {
 
  private:
   struct Group;
-  std::string rtl_dir_, work_root_;
+  std::string rtl_dir_, work_root_, simulator_;
   bool quiet_;
   std::vector<std::unique_ptr<Group>> groups_;
 };
