@@ -242,9 +242,10 @@ int cmd_simulate(const Args& args) {
            "stream also through the Verilated receiver (built at run time), whose events must be identical");
   p.flag("--check-rtl", "the same as --precision rtl");
   p.option("--rtl", "DIR", "with --precision rtl: the RTL sources (default: the project's rtl/)");
-  p.option("--rtl-simulator", "verilator|postsynth",
-           "with --precision rtl: what runs the streams: verilator (the RTL) or postsynth (the iCE40\n"
-           "gate-level netlist of yosys synth_ice40 -dsp, Verilated with yosys' cell models)", "verilator");
+  p.option("--rtl-simulator", "verilator|postsynth|icarus",
+           "with --precision rtl: what runs the streams: verilator (the RTL), postsynth (the iCE40\n"
+           "gate-level netlist of yosys synth_ice40 -dsp, Verilated with yosys' cell models) or icarus\n"
+           "(the RTL in Icarus Verilog: slow, for cross-checking the simulator)", "verilator");
   p.option("--out", "DIR", "output directory (created); default out/<scene name>");
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
@@ -269,8 +270,8 @@ int cmd_simulate(const Args& args) {
   }
   if (p.has("--rtl") && !rtl) throw InputError("option --rtl: only with --precision rtl or --check-rtl");
   const std::string rtl_sim = p.get_or("--rtl-simulator", "verilator");
-  if (rtl_sim != "verilator" && rtl_sim != "postsynth") {
-    throw InputError("option --rtl-simulator: '" + rtl_sim + "' is not valid; valid: verilator, postsynth");
+  if (rtl_sim != "verilator" && rtl_sim != "postsynth" && rtl_sim != "icarus") {
+    throw InputError("option --rtl-simulator: '" + rtl_sim + "' is not valid; valid: verilator, postsynth, icarus");
   }
   if (p.has("--rtl-simulator") && !rtl) throw InputError("option --rtl-simulator: only with --precision rtl or --check-rtl");
   if (rtl) scene.receiver.precision = "fixed";
@@ -377,7 +378,9 @@ int cmd_simulate(const Args& args) {
     }
     if (rtl) {
       const auto& r = summary["rtl"];
-      text << "\nRTL (" << (rtl_sim == "postsynth" ? "Verilated iCE40 gate-level netlist" : "Verilated receiver_top")
+      text << "\nRTL (" << (rtl_sim == "postsynth" ? "Verilated iCE40 gate-level netlist"
+                             : rtl_sim == "icarus"  ? "receiver_top in Icarus Verilog"
+                                                    : "Verilated receiver_top")
            << "): " << r["streams"] << " streams, " << r["events_compared"]
            << " events compared with the fixed model, " << r["mismatches"] << " mismatches"
            << (r["pass"].get<bool>() ? ": identical\n" : "\n");

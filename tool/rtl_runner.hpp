@@ -22,7 +22,8 @@ struct RtlBuildOptions {
   std::string origin;        // configuration name for the generated banners
   bool trace = false;        // compile FST tracing in (RANGING_TRACE=1 switches it on)
   // What is Verilated: "verilator" the RTL; "postsynth" the gate-level netlist of yosys
-  // synth_ice40 -dsp (as the bitstream flow synthesizes it; SB_* cells from yosys' cells_sim.v).
+  // synth_ice40 -dsp (as the bitstream flow synthesizes it; SB_* cells from yosys' cells_sim.v);
+  // "icarus" the RTL in Icarus Verilog (iverilog -g2012, a generated testbench).
   std::string simulator = "verilator";
   bool quiet = false;        // no progress on stderr
 };
@@ -73,6 +74,7 @@ class RtlReceiver {
   bool rebuilt() const { return rebuilt_; }
 
  private:
+  void build_icarus(const std::filesystem::path& work);
   const ReceiverDesign& design_;
   RtlBuildOptions opt_;
   std::filesystem::path driver_;
