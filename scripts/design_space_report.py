@@ -225,8 +225,9 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
                  f"bitstream: {lr['summary']}.\n")
     L.append("## Notes\n")
     L.append("- `hardware.clock_hz` is the clocks-per-sample axis: the bandpass shares its multipliers over "
-             "clock_hz / fs clocks (SAMPLE_CYCLES), and 20 MHz (4 clocks) is below the 6 the bandpass needs: "
-             "such points are evaluated (the model is clock-free) but marked NOT real time.")
+             "clock_hz / fs clocks (SAMPLE_CYCLES); the values are multiples of the 1.5 Mbaud UART's rate, "
+             "because `ranging generate` (and so the synthesis of a point) refuses a clock the UART divider does "
+             "not divide. Clocks above the UP5K's ~33 MHz Fmax are receivers for a faster part (ECP5 columns).")
     if cname != "lut4":
         L.append("- `word_bits` ignores the structure (taps, sections, sharing): the synthesis table is the measured cost "
                  "for the points it holds.")
@@ -236,8 +237,6 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
                  "`--place` is not in this run.")
     L.append("- M1 (7 codes of 7 chips, m-sequence shifts) and Gold4 (9 Gold codes of 7 chips) are different code sets; the default "
              "(Gold4) is compared with Gold4 points only.")
-    L.append("- 40 MHz points are receivers only: the system top refuses 40 MHz (clk_hz / baud = 26.67 for its "
-             "1.5 Mbaud UART, `ranging generate`), so they are not bitstream candidates as they stand.")
     L.append("- The word-length minima hold on this one scene (greedy, monotone assumption, "
              "docs/design-space.md); a new default needs a margin check on more scenes.\n")
     L.append(f"## Refused points ({len(refused)})\n")

@@ -199,3 +199,22 @@ TEST(SimulateRtl, SceneEventsThroughIcarusEqualTheFixedModels) {
   b << std::ifstream(scratch() / "fixed-ic/measurements.csv").rdbuf();
   EXPECT_EQ(a.str(), b.str());
 }
+
+// The HLS C++ (C simulation, compiled at run time against the IP folder's configuration):
+// the scene's events equal the fixed model's.
+TEST(SimulateRtl, SceneEventsThroughTheHlsCSimulationEqualTheFixedModels) {
+  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
+  const auto fixed = run_tool("simulate " + scene + " --precision fixed --quiet --out " + (scratch() / "fixed-hls").string());
+  ASSERT_EQ(fixed.status, 0) << fixed.err;
+  const auto r = run_tool("simulate " + scene + " --precision rtl --rtl-simulator hls --json --quiet --out " +
+                          (scratch() / "hls").string());
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["rtl"]["simulator"], "hls");
+  EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
+  EXPECT_GT(j["rtl"]["events_compared"].get<int>(), 0);
+  std::stringstream a, b;
+  a << std::ifstream(scratch() / "hls/measurements.csv").rdbuf();
+  b << std::ifstream(scratch() / "fixed-hls/measurements.csv").rdbuf();
+  EXPECT_EQ(a.str(), b.str());
+}

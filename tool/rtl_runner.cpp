@@ -137,11 +137,16 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
   if (shell("command -v verilator >/dev/null 2>&1") != 0) {
     throw InputError("verilator is not installed (Debian: apt-get install verilator)");
   }
-  if (opt_.simulator != "verilator" && opt_.simulator != "postsynth" && opt_.simulator != "icarus") {
-    throw InputError("simulator '" + opt_.simulator + "': valid are verilator, postsynth, icarus");
+  if (opt_.simulator != "verilator" && opt_.simulator != "postsynth" && opt_.simulator != "icarus" &&
+      opt_.simulator != "hls") {
+    throw InputError("simulator '" + opt_.simulator + "': valid are verilator, postsynth, icarus, hls");
   }
   if (opt_.simulator == "icarus") {
     build_icarus(work);
+    return;
+  }
+  if (opt_.simulator == "hls") {
+    build_hls(work);
     return;
   }
   const bool gates = opt_.simulator == "postsynth";
@@ -304,6 +309,31 @@ void RtlReceiver::build_icarus(const fs::path& work) {
   rebuilt_ = true;
 }
 
+// The HLS C++ of the IP folder (hls/*.hpp and this configuration's receiver_config.hpp),
+// compiled with the host compiler around tb/hls_driver.cpp.
+void RtlReceiver::build_hls(const fs::path& work) {
+  const std::string src = build_info::kSourceDir;
+  const fs::path driver_src = fs::path(src) / "tb/hls_driver.cpp";
+  if (!fs::exists(driver_src)) throw InputError("cannot find the driver source " + driver_src.string());
+  const char* cxx_env = std::getenv("CXX");
+  const std::string cxx = cxx_env && *cxx_env ? cxx_env : "c++";
+  const fs::path obj = work / "obj-hls";
+  fs::create_directories(obj);
+  driver_ = obj / "hls_driver";
+  const std::string cmd = quote(cxx) + " -std=c++20 -O2 -I " + quote((work / "ip").string()) + " -o " +
+                          quote(driver_.string()) + " " + quote(driver_src.string());
+  std::uint64_t key = fnv1a(cmd + read(driver_src));
+  for (const auto& e : fs::directory_iterator(work / "ip/hls")) key = fnv1a(read(e.path()), key);
+  const fs::path stamp_file = obj / ".ranging-stamp";
+  if (fs::exists(driver_) && read(stamp_file) == std::to_string(key)) return;
+  const fs::path log = work / "build-hls.log";
+  if (shell(cmd + " > " + quote(log.string()) + " 2>&1") != 0 || !fs::exists(driver_)) {
+    throw InputError("the HLS C++ of this configuration does not compile (" + cxx + "); log: " + log.string());
+  }
+  std::ofstream(stamp_file) << key;
+  rebuilt_ = true;
+}
+
 std::vector<RtlResult> RtlReceiver::run(const std::vector<RtlStimulus>& stimuli) const {
   const fs::path dir = opt_.work_dir / "runs";
   fs::create_directories(dir);
@@ -383,6 +413,13 @@ std::vector<RtlResult> RtlReceiver::run(const std::vector<RtlStimulus>& stimuli)
       ev.arrival = b.sget(code_w_, arrival_w);
       ev.score = b.get(code_w_ + arrival_w, score_w_);
       ev.margin = b.get(code_w_ + arrival_w + score_w_, score_w_);
+      seg.events.push_back(ev);
+    } else if (tag == "V") {  // an event from the HLS driver, in decimal fields
+      EventFixed ev;
+      std::uint64_t score = 0, margin = 0;
+      ls >> ev.code >> ev.arrival >> score >> margin;
+      ev.score = score;
+      ev.margin = margin;
       seg.events.push_back(ev);
     } else if (tag == "R") {
       r.segments.emplace_back();

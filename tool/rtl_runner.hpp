@@ -23,7 +23,8 @@ struct RtlBuildOptions {
   bool trace = false;        // compile FST tracing in (RANGING_TRACE=1 switches it on)
   // What is Verilated: "verilator" the RTL; "postsynth" the gate-level netlist of yosys
   // synth_ice40 -dsp (as the bitstream flow synthesizes it; SB_* cells from yosys' cells_sim.v);
-  // "icarus" the RTL in Icarus Verilog (iverilog -g2012, a generated testbench).
+  // "icarus" the RTL in Icarus Verilog (iverilog -g2012, a generated testbench); "hls" the HLS
+  // C++ (C simulation: events only, tb/hls_driver.cpp).
   std::string simulator = "verilator";
   bool quiet = false;        // no progress on stderr
 };
@@ -75,6 +76,7 @@ class RtlReceiver {
 
  private:
   void build_icarus(const std::filesystem::path& work);
+  void build_hls(const std::filesystem::path& work);
   const ReceiverDesign& design_;
   RtlBuildOptions opt_;
   std::filesystem::path driver_;
