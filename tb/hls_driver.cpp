@@ -7,7 +7,7 @@
 //   run NAME                 a run
 //   V code arrival score margin   an event (decimal; arrival signed)
 //   R                        reset here
-//   end <samples> 0
+//   end <samples> 0 0
 #include <cinttypes>
 #include <cstdio>
 #include <vector>
@@ -31,10 +31,10 @@ int main(int argc, char** argv) {
   static ranging_hls::Receiver<Cfg> rx;  // static: large state
   char name[256];
   double valid_prob, ready_prob;
-  unsigned long long seed, quiet, n;
+  unsigned long long seed, quiet, n, cadence;  // cadence: unused (no clock in C simulation)
   long long reset_at;
-  while (std::fscanf(in, " run %255s %lf %lf %llu %lld %llu %llu", name, &valid_prob, &ready_prob, &seed, &reset_at,
-                     &quiet, &n) == 7) {
+  while (std::fscanf(in, " run %255s %lf %lf %llu %lld %llu %llu %llu", name, &valid_prob, &ready_prob, &seed,
+                     &reset_at, &quiet, &n, &cadence) == 8) {
     std::vector<std::int64_t> x(n);
     for (auto& v : x) {
       std::uint64_t u = 0;
@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
         std::fprintf(out, "V %" PRId64 " %" PRId64 " %" PRIu64 " %" PRIu64 "\n", ev.code, ev.arrival, ev.score, ev.margin);
       }
     }
-    std::fprintf(out, "end %zu 0\n", x.size());
+    std::fprintf(out, "end %zu 0 0\n", x.size());
   }
   std::fclose(out);
   std::fclose(in);

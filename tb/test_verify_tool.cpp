@@ -218,3 +218,32 @@ TEST(SimulateRtl, SceneEventsThroughTheHlsCSimulationEqualTheFixedModels) {
   b << std::ifstream(scratch() / "fixed-hls/measurements.csv").rdbuf();
   EXPECT_EQ(a.str(), b.str());
 }
+
+// The real-time rule (model/hw/realtime.hpp) against the RTL on a sample of design points:
+// verify offers a coded stream at one sample every clock_hz / fs clocks and counts the samples
+// the RTL takes late. The rule and the RTL must agree: the default (6 of 6 clocks), DECIM 10
+// at 30 MHz (NOT real time: 19.7 clocks needed, 6 available) and DECIM 10 at 120 MHz (24).
+TEST(Verify, TheRealTimeRuleAgreesWithThePacedRtl) {
+  struct Point {
+    const char* name;
+    const char* yaml;
+    bool real_time;
+  };
+  const std::vector<Point> points = {
+      {"default", "", true},
+      {"decim10", "correlator:\n  decimation: 10\n", false},
+      {"decim10-120mhz", "correlator:\n  decimation: 10\nhardware:\n  clock_hz: 120000000\n", true},
+  };
+  for (const auto& pt : points) {
+    SCOPED_TRACE(pt.name);
+    const fs::path cfg = scratch() / (std::string(pt.name) + ".yaml");
+    std::ofstream(cfg) << "name: rt-" << pt.name << "\n" << pt.yaml;
+    const auto r = run_tool("verify --config " + cfg.string() + " --json --quiet --out " + (scratch() / pt.name).string());
+    const auto j = nlohmann::json::parse(r.out);
+    const auto& rt = j["realtime"];
+    EXPECT_EQ(rt["rule_real_time"].get<bool>(), pt.real_time) << rt.dump();
+    EXPECT_TRUE(rt["agree"].get<bool>()) << rt.dump();
+    EXPECT_EQ(rt["late_samples"].get<int>() == 0, pt.real_time) << rt.dump();
+    EXPECT_EQ(r.status, 0) << r.err;  // a NOT REAL TIME design the RTL confirms is no failure of verify
+  }
+}

@@ -7,10 +7,12 @@
 //
 // Usage: verify_driver STIMULUS OUTPUT
 // STIMULUS (text), any number of runs:
-//   run NAME VALID_PROB READY_PROB SEED RESET_AT QUIET N
+//   run NAME VALID_PROB READY_PROB SEED RESET_AT QUIET N CADENCE
 //   x_0 ... x_{N-1}              (s_axis_tdata values, already masked to IN_W bits)
 // RESET_AT: the sample index before which rst is pulsed mid-stream (-1: none). QUIET: clock
 // cycles without any output beat, after the last sample was taken, that end the run.
+// CADENCE: 0, samples offered with probability VALID_PROB each cycle; K > 0, sample i is due at
+// cycle i K (an ADC at clk / K; VALID_PROB unused) and one taken after its due cycle is late.
 // OUTPUT, per run:
 //   run NAME
 //   F <dbg_filter_data> <dbg_filter_sections>                  a filter output (hex)
@@ -18,7 +20,7 @@
 //   E <m_axis_tdata>                                           an event
 //   R                                                          rst pulsed here
 //   S <samples taken>                                          stalled: s_axis_tready stuck low
-//   end <samples taken> <cycles>
+//   end <samples taken> <cycles> <late samples>
 // Hex values are the whole port, most significant word first (VlWide: 32-bit words).
 // RANGING_TRACE=1 writes $RANGING_TRACE_DIR/verify_<NAME>.fst (when compiled with --trace-fst;
 // tb/verilator_harness.hpp, "." when RANGING_TRACE_DIR is unset).
@@ -69,10 +71,10 @@ int main(int argc, char** argv) {
   }
   char name[256];
   double valid_prob, ready_prob;
-  unsigned long long seed, quiet, n;
+  unsigned long long seed, quiet, n, cadence;
   long long reset_at;
-  while (std::fscanf(in, " run %255s %lf %lf %llu %lld %llu %llu", name, &valid_prob, &ready_prob, &seed, &reset_at,
-                     &quiet, &n) == 7) {
+  while (std::fscanf(in, " run %255s %lf %lf %llu %lld %llu %llu %llu", name, &valid_prob, &ready_prob, &seed,
+                     &reset_at, &quiet, &n, &cadence) == 8) {
     std::vector<std::uint64_t> x(n);
     for (auto& v : x) {
       if (std::fscanf(in, "%" SCNu64, &v) != 1) {
@@ -86,7 +88,7 @@ int main(int argc, char** argv) {
     Dut d(std::string("verify_") + name);
     reset(d);
     std::size_t next = 0;
-    std::uint64_t cycles = 0, idle = 0, silent = 0;
+    std::uint64_t cycles = 0, idle = 0, silent = 0, late = 0, due = 0;
     bool stalled = false;
     while (next < x.size() || silent < quiet) {
       if (reset_at >= 0 && next == static_cast<std::size_t>(reset_at)) {
@@ -94,7 +96,7 @@ int main(int argc, char** argv) {
         std::fprintf(out, "R\n");
         reset_at = -1;
       }
-      const bool offer = next < x.size() && u(rng) < valid_prob;
+      const bool offer = next < x.size() && (cadence ? cycles >= due : u(rng) < valid_prob);
       d.top().s_axis_tvalid = offer;
       if (offer) d.top().s_axis_tdata = static_cast<std::remove_reference_t<decltype(d.top().s_axis_tdata)>>(x[next]);
       d.top().m_axis_tready = u(rng) < ready_prob;
@@ -103,6 +105,10 @@ int main(int argc, char** argv) {
       if (offer && d.top().s_axis_tready) {
         ++next;
         idle = 0;
+        if (cadence) {
+          if (cycles > due) ++late;
+          due += cadence;
+        }
       }
       auto& t = d.top();
       if (t.dbg_filter_valid) {
@@ -141,7 +147,7 @@ int main(int argc, char** argv) {
       }
     }
     if (stalled) std::fprintf(out, "S %zu\n", next);
-    std::fprintf(out, "end %zu %" PRIu64 "\n", next, cycles);
+    std::fprintf(out, "end %zu %" PRIu64 " %" PRIu64 "\n", next, cycles, late);
   }
   std::fclose(out);
   std::fclose(in);

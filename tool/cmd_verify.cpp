@@ -15,6 +15,7 @@
 #include "model/config/receiver_config.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/hw/hw_params.hpp"
+#include "model/hw/realtime.hpp"
 #include "model/sim/channel.hpp"
 #include "tool/build_info.hpp"
 #include "tool/cli.hpp"
@@ -329,9 +330,31 @@ int cmd_verify(const Args& args) {
     }
   }
 
+  // The real-time rule (model/hw/realtime.hpp) against the RTL: the first coded stream offered
+  // as an ADC would, one sample every clock_hz / fs clocks; a sample the RTL takes after its due
+  // cycle is late. A design the rule calls real time must have none.
+  const RealTimeBudget budget = realtime_budget(design);
+  RtlStimulus paced = runs.front();
+  paced.name = "paced-" + paced.name;
+  paced.cadence = budget.clocks_per_sample;
+  paced.valid_prob = 1.0;
+  paced.ready_prob = 1.0;
+  paced.reset_at = -1;
+  const RtlResult pr = rtl.run({paced}).front();
+  const bool rule_rt = budget.real_time;
+  const bool rtl_rt = pr.late == 0 && !pr.stalled && pr.samples_taken == paced.x.size();
+  const bool rt_ok = !rule_rt || rtl_rt;  // a conservative rule (NOT REAL TIME, RTL keeps up) is no failure
+  const std::string rt_text =
+      std::string("real-time rule: ") + budget.summary() + "\n  RTL at one sample every " +
+      std::to_string(budget.clocks_per_sample) + " clocks (" + paced.name + "): " + std::to_string(pr.late) + " of " +
+      std::to_string(paced.x.size()) + " samples late" +
+      (rule_rt == rtl_rt ? ": agrees with the rule"
+                         : rule_rt ? ": the RTL falls behind a design the rule calls real time (FAIL)"
+                                   : ": the RTL keeps up where the rule says it does not (the rule is conservative here)");
+
   std::uint64_t mismatches = 0;
   for (const auto& st : cmp.stage) mismatches += st.mismatches;
-  const bool pass = mismatches == 0 && !stalled;
+  const bool pass = mismatches == 0 && !stalled && rt_ok;
   // The first mismatch: the earliest stage of the earliest failing run.
   const Mismatch* first = nullptr;
   auto stage_rank = [](const std::string& s) {
@@ -362,6 +385,16 @@ int cmd_verify(const Args& args) {
                              {"mismatches", cmp.stage[i].mismatches}});
     }
     j["runs"] = run_json;
+    j["realtime"] = {{"rule_real_time", rule_rt},
+                     {"rule", budget.summary()},
+                     {"clocks_per_sample", budget.clocks_per_sample},
+                     {"needed_clocks_per_sample", budget.needed_clocks_per_sample()},
+                     {"run", paced.name},
+                     {"samples", paced.x.size()},
+                     {"late_samples", pr.late},
+                     {"rtl_real_time", rtl_rt},
+                     {"agree", rule_rt == rtl_rt},
+                     {"pass", rt_ok}};
     j["first_mismatch"] = first ? nlohmann::json{{"stage", first->stage}, {"run", first->run}, {"sample", first->where},
                                                  {"expected", first->expected}, {"got", first->got}}
                                 : nlohmann::json(nullptr);
@@ -374,6 +407,7 @@ int cmd_verify(const Args& args) {
       std::cout << "  " << kStages[i] << std::string(16 - std::string(kStages[i]).size(), ' ')
                 << cmp.stage[i].compared << " compared, " << cmp.stage[i].mismatches << " mismatches\n";
     }
+    std::cout << rt_text << "\n";
     if (first) {
       std::cout << "first mismatch: stage " << first->stage << ", run " << first->run << ", " << first->where
                 << ": expected " << first->expected << ", got " << first->got << "\n";

@@ -252,7 +252,8 @@ void RtlReceiver::build_icarus(const fs::path& work) {
         "    .dbg_bank_valid(b_valid), .dbg_weighted(b_weighted), .dbg_code(b_code), .dbg_last(b_last),\n"
         "    .dbg_energy(b_energy), .dbg_index(b_index), .dbg_chip_re(b_chip_re), .dbg_chip_im(b_chip_im),\n"
         "    .dbg_corr_re(b_corr_re), .dbg_corr_im(b_corr_im));\n"
-        "  integer fin, fout, rc, vp, rp, seed, reset_at, quiet, n, i, next, idle, silent, cycles, beat, offer;\n"
+        "  integer fin, fout, rc, vp, rp, seed, reset_at, quiet, n, cadence, i, next, idle, silent, cycles, beat, offer;\n"
+        "  integer late, due;\n"
         "  reg [8*64-1:0] name;\n"
         "  reg [" << in_w_ - 1 << ":0] x [0:" << (1 << 20) - 1 << "];\n"
         "  reg [" << 8 * 1024 - 1 << ":0] stim_path, out_path;\n"
@@ -263,17 +264,18 @@ void RtlReceiver::build_icarus(const fs::path& work) {
         "      $display(\"usage: vvp sim +stim=FILE +out=FILE\"); $finish_and_return(2); end\n"
         "    fin = $fopen(stim_path, \"r\"); fout = $fopen(out_path, \"w\");\n"
         "    if (fin == 0 || fout == 0) begin $display(\"cannot open the stimulus or output\"); $finish_and_return(2); end\n"
-        "    while ($fscanf(fin, \" run %s %d %d %d %d %d %d\", name, vp, rp, seed, reset_at, quiet, n) == 7) begin\n"
+        "    while ($fscanf(fin, \" run %s %d %d %d %d %d %d %d\", name, vp, rp, seed, reset_at, quiet, n, cadence) == 8) begin\n"
         "      for (i = 0; i < n; i = i + 1) rc = $fscanf(fin, \"%d\", x[i]);\n"
         "      $fwrite(fout, \"run %0s\\n\", name);\n"
-        "      do_reset; next = 0; cycles = 0; idle = 0; silent = 0;\n"
+        "      do_reset; next = 0; cycles = 0; idle = 0; silent = 0; late = 0; due = 0;\n"
         "      while (next < n || silent < quiet) begin\n"
         "        if (reset_at >= 0 && next == reset_at) begin do_reset; $fwrite(fout, \"R\\n\"); reset_at = -1; end\n"
-        "        offer = (next < n) && (($random(seed) & 32'h7fffffff) % 1000000 < vp);\n"
+        "        offer = (next < n) && (cadence > 0 ? cycles >= due : (($random(seed) & 32'h7fffffff) % 1000000 < vp));\n"
         "        s_valid = offer; if (offer) s_data = x[next];\n"
         "        m_ready = (($random(seed) & 32'h7fffffff) % 1000000 < rp);\n"
         "        #1; beat = 0;\n"
-        "        if (offer && s_ready) begin next = next + 1; idle = 0; end\n"
+        "        if (offer && s_ready) begin next = next + 1; idle = 0;\n"
+        "          if (cadence > 0) begin if (cycles > due) late = late + 1; due = due + cadence; end end\n"
         "        if (f_valid) begin $fwrite(fout, \"F %h %h\\n\", f_data, f_sections); beat = 1; end\n"
         "        if (b_valid) begin $fwrite(fout, \"B %h %h %h %h %h %h %h %h %h\\n\", b_code, b_last, b_weighted,\n"
         "            b_energy, b_index, b_chip_re, b_chip_im, b_corr_re, b_corr_im); beat = 1; end\n"
@@ -283,7 +285,7 @@ void RtlReceiver::build_icarus(const fs::path& work) {
         "        silent = (beat || next < n) ? 0 : silent + 1;\n"
         "        if (next < n) begin idle = idle + 1; if (idle > 200000) begin $fwrite(fout, \"S %0d\\n\", next); quiet = 0; n = next; end end\n"
         "      end\n"
-        "      $fwrite(fout, \"end %0d %0d\\n\", next, cycles);\n"
+        "      $fwrite(fout, \"end %0d %0d %0d\\n\", next, cycles, late);\n"
         "    end\n"
         "    $fclose(fout); $finish;\n"
         "  end\n"
@@ -345,10 +347,10 @@ std::vector<RtlResult> RtlReceiver::run(const std::vector<RtlStimulus>& stimuli)
       if (opt_.simulator == "icarus") {  // integer probabilities (per million) for $fscanf %d
         if (s.x.size() > (std::size_t{1} << 20)) throw InputError("icarus: a stream of more than 2^20 samples");
         f << "run " << s.name << " " << std::llround(s.valid_prob * 1e6) << " " << std::llround(s.ready_prob * 1e6)
-          << " " << (s.seed & 0x7fffffff) << " " << s.reset_at << " 50000 " << s.x.size() << "\n";
+          << " " << (s.seed & 0x7fffffff) << " " << s.reset_at << " 50000 " << s.x.size() << " " << s.cadence << "\n";
       } else {
         f << "run " << s.name << " " << s.valid_prob << " " << s.ready_prob << " " << s.seed << " " << s.reset_at
-          << " 50000 " << s.x.size() << "\n";
+          << " 50000 " << s.x.size() << " " << s.cadence << "\n";
       }
       for (std::size_t i = 0; i < s.x.size(); ++i) {
         f << (static_cast<std::uint64_t>(s.x[i]) & mask) << ((i + 1) % 16 == 0 ? "\n" : " ");
@@ -426,7 +428,7 @@ std::vector<RtlResult> RtlReceiver::run(const std::vector<RtlStimulus>& stimuli)
     } else if (tag == "S") {
       r.stalled = true;
     } else if (tag == "end") {
-      ls >> r.samples_taken >> r.cycles;
+      ls >> r.samples_taken >> r.cycles >> r.late;
     }
   }
   if (results.size() != stimuli.size()) throw std::runtime_error("driver output: runs missing");

@@ -38,6 +38,9 @@ struct RtlStimulus {
   double valid_prob = 1.0, ready_prob = 1.0;
   std::uint64_t seed = 1;
   long long reset_at = -1;          // rst pulsed before sample reset_at (-1: never)
+  // 0: samples offered with valid_prob each cycle; K > 0: sample i due at cycle i K (an ADC at
+  // clk / K), and RtlResult::late counts those taken after their due cycle.
+  long long cadence = 0;
   std::vector<std::int64_t> x;      // signed ADC samples (input_bits)
 };
 
@@ -61,7 +64,7 @@ struct RtlResult {
   std::string name;
   std::vector<RtlSegment> segments;  // one more than the resets applied
   bool stalled = false;
-  std::uint64_t samples_taken = 0, cycles = 0;
+  std::uint64_t samples_taken = 0, cycles = 0, late = 0;
 };
 
 class RtlReceiver {
