@@ -247,3 +247,22 @@ TEST(Verify, TheRealTimeRuleAgreesWithThePacedRtl) {
     EXPECT_EQ(r.status, 0) << r.err;  // a NOT REAL TIME design the RTL confirms is no failure of verify
   }
 }
+
+// The RTL Verilated as an SC_MODULE (verilator --sc) and driven under the SystemC kernel
+// (tb/verify_driver_sc.cpp): the scene's events equal the fixed model's.
+TEST(SimulateRtl, SceneEventsThroughSystemCEqualTheFixedModels) {
+  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
+  const auto fixed = run_tool("simulate " + scene + " --precision fixed --quiet --out " + (scratch() / "fixed-sc").string());
+  ASSERT_EQ(fixed.status, 0) << fixed.err;
+  const auto r = run_tool("simulate " + scene + " --precision rtl --rtl-simulator systemc --json --quiet --out " +
+                          (scratch() / "systemc").string());
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["rtl"]["simulator"], "systemc");
+  EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
+  EXPECT_GT(j["rtl"]["events_compared"].get<int>(), 0);
+  std::stringstream a, b;
+  a << std::ifstream(scratch() / "systemc/measurements.csv").rdbuf();
+  b << std::ifstream(scratch() / "fixed-sc/measurements.csv").rdbuf();
+  EXPECT_EQ(a.str(), b.str());
+}

@@ -242,11 +242,12 @@ int cmd_simulate(const Args& args) {
            "stream also through the Verilated receiver (built at run time), whose events must be identical");
   p.flag("--check-rtl", "the same as --precision rtl");
   p.option("--rtl", "DIR", "with --precision rtl: the RTL sources (default: the project's rtl/)");
-  p.option("--rtl-simulator", "verilator|postsynth|icarus|hls",
+  p.option("--rtl-simulator", "verilator|postsynth|icarus|hls|systemc",
            "with --precision rtl: what runs the streams: verilator (the RTL), postsynth (the iCE40\n"
            "gate-level netlist of yosys synth_ice40 -dsp, Verilated with yosys' cell models) or icarus\n"
            "(the RTL in Icarus Verilog: slow, for cross-checking the simulator) or hls (the HLS C++,\n"
-           "C simulation: events only)", "verilator");
+           "C simulation: events only) or systemc (the RTL Verilated as an SC_MODULE, driven under the\n"
+           "SystemC kernel)", "verilator");
   p.option("--out", "DIR", "output directory (created); default out/<scene name>");
   p.flag("--json", "print the summary JSON on stdout instead of the text summary");
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
@@ -271,8 +272,10 @@ int cmd_simulate(const Args& args) {
   }
   if (p.has("--rtl") && !rtl) throw InputError("option --rtl: only with --precision rtl or --check-rtl");
   const std::string rtl_sim = p.get_or("--rtl-simulator", "verilator");
-  if (rtl_sim != "verilator" && rtl_sim != "postsynth" && rtl_sim != "icarus" && rtl_sim != "hls") {
-    throw InputError("option --rtl-simulator: '" + rtl_sim + "' is not valid; valid: verilator, postsynth, icarus, hls");
+  if (rtl_sim != "verilator" && rtl_sim != "postsynth" && rtl_sim != "icarus" && rtl_sim != "hls" &&
+      rtl_sim != "systemc") {
+    throw InputError("option --rtl-simulator: '" + rtl_sim +
+                     "' is not valid; valid: verilator, postsynth, icarus, hls, systemc");
   }
   if (p.has("--rtl-simulator") && !rtl) throw InputError("option --rtl-simulator: only with --precision rtl or --check-rtl");
   if (rtl) scene.receiver.precision = "fixed";
@@ -382,6 +385,7 @@ int cmd_simulate(const Args& args) {
       text << "\nRTL (" << (rtl_sim == "postsynth" ? "Verilated iCE40 gate-level netlist"
                              : rtl_sim == "icarus"  ? "receiver_top in Icarus Verilog"
                              : rtl_sim == "hls"     ? "HLS C++, C simulation"
+                             : rtl_sim == "systemc" ? "Verilated receiver_top under SystemC"
                                                     : "Verilated receiver_top")
            << "): " << r["streams"] << " streams, " << r["events_compared"]
            << " events compared with the fixed model, " << r["mismatches"] << " mismatches"

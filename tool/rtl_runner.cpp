@@ -132,14 +132,15 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
   write_hardware_files(files, (work / "ip").string());
 
   // 2. The Verilated driver, rebuilt only when a source or the command changes.
-  const fs::path driver_src = fs::path(src) / "tb/verify_driver.cpp";
+  const bool sc = opt_.simulator == "systemc";
+  const fs::path driver_src = fs::path(src) / (sc ? "tb/verify_driver_sc.cpp" : "tb/verify_driver.cpp");
   if (!fs::exists(driver_src)) throw InputError("cannot find the testbench source " + driver_src.string());
   if (shell("command -v verilator >/dev/null 2>&1") != 0) {
     throw InputError("verilator is not installed (Debian: apt-get install verilator)");
   }
   if (opt_.simulator != "verilator" && opt_.simulator != "postsynth" && opt_.simulator != "icarus" &&
-      opt_.simulator != "hls") {
-    throw InputError("simulator '" + opt_.simulator + "': valid are verilator, postsynth, icarus, hls");
+      opt_.simulator != "hls" && opt_.simulator != "systemc") {
+    throw InputError("simulator '" + opt_.simulator + "': valid are verilator, postsynth, icarus, hls, systemc");
   }
   if (opt_.simulator == "icarus") {
     build_icarus(work);
@@ -150,7 +151,19 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
     return;
   }
   const bool gates = opt_.simulator == "postsynth";
-  const fs::path obj = work / (gates ? "obj-postsynth" : "obj");
+  const fs::path obj = work / (gates ? "obj-postsynth" : sc ? "obj-systemc" : "obj");
+  std::string sc_env;
+  if (sc) {
+    // Debian's libsystemc-dev: headers in /usr/include, the library in the multiarch folder.
+    const char* inc = std::getenv("SYSTEMC_INCLUDE");
+    const char* lib = std::getenv("SYSTEMC_LIBDIR");
+    const std::string inc_dir = inc && *inc ? inc : "/usr/include";
+    const std::string lib_dir = lib && *lib ? lib : "/usr/lib/x86_64-linux-gnu";
+    if (!fs::exists(fs::path(inc_dir) / "systemc.h")) {
+      throw InputError("SystemC is not installed (" + inc_dir + "/systemc.h; Debian: apt-get install libsystemc-dev)");
+    }
+    sc_env = "SYSTEMC_INCLUDE=" + quote(inc_dir) + " SYSTEMC_LIBDIR=" + quote(lib_dir) + " ";
+  }
   driver_ = obj / "verify_driver";
   std::string sources = "-f files.f";
   std::string netlist_cmd;
@@ -184,8 +197,9 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
                   "../receiver_top_syn.v' > /dev/null 2>&1";
     sources = "-DNO_ICE40_DEFAULT_ASSIGNMENTS ../receiver_top_syn.v " + quote(datdir + "/ice40/cells_sim.v");
   }
-  const std::string cmd = "cd " + quote((work / "ip").string()) +
-                          " && verilator --cc --exe --build -j 2 -Wno-fatal -Wno-lint -Wno-style" +
+  const std::string cmd = "cd " + quote((work / "ip").string()) + " && " + sc_env + "verilator " +
+                          std::string(sc ? "--sc -CFLAGS -DSC_CPLUSPLUS=201703L" : "--cc") +
+                          " --exe --build -j 2 -Wno-fatal -Wno-lint -Wno-style" +
                           std::string(gates ? " --no-timing" : "") +
                           " --x-assign unique --x-initial unique -O3 -CFLAGS -O1" +
                           std::string(opt_.trace ? " --trace-fst" : "") + " " + sources +

@@ -24,7 +24,8 @@ struct RtlBuildOptions {
   // What is Verilated: "verilator" the RTL; "postsynth" the gate-level netlist of yosys
   // synth_ice40 -dsp (as the bitstream flow synthesizes it; SB_* cells from yosys' cells_sim.v);
   // "icarus" the RTL in Icarus Verilog (iverilog -g2012, a generated testbench); "hls" the HLS
-  // C++ (C simulation: events only, tb/hls_driver.cpp).
+  // C++ (C simulation: events only, tb/hls_driver.cpp); "systemc" the RTL Verilated with --sc,
+  // driven under the SystemC kernel (tb/verify_driver_sc.cpp).
   std::string simulator = "verilator";
   bool quiet = false;        // no progress on stderr
 };
