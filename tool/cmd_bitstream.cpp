@@ -30,17 +30,13 @@
 #include "tool/commands.hpp"
 #include "tool/guard.hpp"
 #include "tool/rtl_runner.hpp"
+#include "tool/shell.hpp"
 
 namespace ranging::tool {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
 
 int exit_status(int st) { return (st != -1 && WIFEXITED(st)) ? WEXITSTATUS(st) : -1; }
 
@@ -56,7 +52,7 @@ int capture(const std::string& cmd, std::string& output) {
 
 bool on_path(const std::string& tool) {
   std::string ignored;
-  return capture("command -v " + quote(tool), ignored) == 0;
+  return capture("command -v " + shell_quote(tool), ignored) == 0;
 }
 
 std::string last_line(const std::string& text) {
@@ -95,7 +91,7 @@ Programmer find_board() {
 void program(const Programmer& p, const std::string& bin) {
   std::cerr << "[bitstream] " << p.write_prefix << bin << "\n";
   std::string out;
-  if (capture(p.write_prefix + quote(bin), out) != 0) {
+  if (capture(p.write_prefix + shell_quote(bin), out) != 0) {
     throw InputError("option --program: `" + p.write_prefix + bin + "` failed: " + last_line(out));
   }
 }
@@ -188,8 +184,8 @@ int cmd_bitstream(const Args& args) {
   std::error_code ec;
   fs::remove(results / "bitstream.json", ec);
   const std::string script = std::string(build_info::kSourceDir) + "/scripts/build_bitstream.sh";
-  std::string cmd = quote(script) + " --config " + quote(config_path) + " --ranging " + quote(self_exe().string()) +
-                    " --out " + quote(out.string()) + " --results " + quote(results.string()) + " --seeds " +
+  std::string cmd = shell_quote(script) + " --config " + shell_quote(config_path) + " --ranging " + shell_quote(self_exe().string()) +
+                    " --out " + shell_quote(out.string()) + " --results " + shell_quote(results.string()) + " --seeds " +
                     std::to_string(seeds) + " --jobs " + std::to_string(jobs) + " --no-large";
   if (!p.has("--estimates")) cmd += " --no-others";
   if (p.has("--check")) cmd += " --check";

@@ -7,16 +7,9 @@
 
 #include "model/base/error.hpp"
 #include "tool/build_info.hpp"
+#include "tool/shell.hpp"
 
 namespace ranging::tool {
-
-namespace {
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-}  // namespace
 
 void check_png_option(const std::string& option, const std::string& path) {
   namespace fs = std::filesystem;
@@ -41,7 +34,7 @@ void plot_with_script(const std::string& option, const std::string& script, cons
     if (!out) throw InputError(option + ": cannot write '" + data_path + "'");
   }
   const std::string path = std::string(build_info::kSourceDir) + "/" + script;
-  const std::string cmd = "/usr/bin/python3 " + quote(path) + " " + quote(data_path) + " " + quote(tmp) + " > /dev/null";
+  const std::string cmd = "/usr/bin/python3 " + shell_quote(path) + " " + shell_quote(data_path) + " " + shell_quote(tmp) + " > /dev/null";
   const int rc = std::system(cmd.c_str());
   std::error_code ec;
   fs::remove(data_path, ec);

@@ -17,17 +17,13 @@
 #include "model/hw/hw_params.hpp"
 #include "model/hw/ip_package.hpp"
 #include "tool/build_info.hpp"
+#include "tool/shell.hpp"
 
 namespace ranging::tool {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
 
 std::string read(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
@@ -162,7 +158,7 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
     if (!fs::exists(fs::path(inc_dir) / "systemc.h")) {
       throw InputError("SystemC is not installed (" + inc_dir + "/systemc.h; Debian: apt-get install libsystemc-dev)");
     }
-    sc_env = "SYSTEMC_INCLUDE=" + quote(inc_dir) + " SYSTEMC_LIBDIR=" + quote(lib_dir) + " ";
+    sc_env = "SYSTEMC_INCLUDE=" + shell_quote(inc_dir) + " SYSTEMC_LIBDIR=" + shell_quote(lib_dir) + " ";
   }
   driver_ = obj / "verify_driver";
   std::string sources = "-f files.f";
@@ -192,19 +188,19 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
     for (std::string line; std::getline(fl, line);) {
       if (!line.empty()) reads += "read_verilog -defer -I. " + line + "; ";
     }
-    netlist_cmd = "cd " + quote((work / "ip").string()) + " && yosys -q -l ../postsynth-yosys.log -p '" + reads +
+    netlist_cmd = "cd " + shell_quote((work / "ip").string()) + " && yosys -q -l ../postsynth-yosys.log -p '" + reads +
                   "hierarchy -top receiver_top; synth_ice40 -dsp -top receiver_top; write_verilog -noattr "
                   "../receiver_top_syn.v' > /dev/null 2>&1";
-    sources = "-DNO_ICE40_DEFAULT_ASSIGNMENTS ../receiver_top_syn.v " + quote(datdir + "/ice40/cells_sim.v");
+    sources = "-DNO_ICE40_DEFAULT_ASSIGNMENTS ../receiver_top_syn.v " + shell_quote(datdir + "/ice40/cells_sim.v");
   }
-  const std::string cmd = "cd " + quote((work / "ip").string()) + " && " + sc_env + "verilator " +
+  const std::string cmd = "cd " + shell_quote((work / "ip").string()) + " && " + sc_env + "verilator " +
                           std::string(sc ? "--sc -CFLAGS -DSC_CPLUSPLUS=201703L" : "--cc") +
                           " --exe --build -j 2 -Wno-fatal -Wno-lint -Wno-style" +
                           std::string(gates ? " --no-timing" : "") +
                           " --x-assign unique --x-initial unique -O3 -CFLAGS -O1" +
                           std::string(opt_.trace ? " --trace-fst" : "") + " " + sources +
-                          " --top-module receiver_top --Mdir " + quote(obj.string()) +
-                          " -o verify_driver " + quote(driver_src.string());
+                          " --top-module receiver_top --Mdir " + shell_quote(obj.string()) +
+                          " -o verify_driver " + shell_quote(driver_src.string());
   std::uint64_t key = fnv1a(netlist_cmd + cmd + read(driver_src));
   for (const char* h : {"tb/verilator_harness.hpp", "tb/bits.hpp"}) key = fnv1a(read(fs::path(src) / h), key);
   std::istringstream list(read(work / "ip/files.f"));
@@ -221,7 +217,7 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
   }
   const auto t0 = std::chrono::steady_clock::now();
   fs::remove(stamp_file, ec);
-  const int rc = shell((netlist_cmd.empty() ? "" : "(" + netlist_cmd + ") && ") + cmd + " > " + quote(log.string()) + " 2>&1");
+  const int rc = shell((netlist_cmd.empty() ? "" : "(" + netlist_cmd + ") && ") + cmd + " > " + shell_quote(log.string()) + " 2>&1");
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!opt_.quiet) std::cerr << (rc == 0 ? " done" : " failed") << " in " << static_cast<int>(build_seconds_) << " s\n";
   if (rc != 0 || !fs::exists(driver_)) {
@@ -307,8 +303,8 @@ void RtlReceiver::build_icarus(const fs::path& work) {
   const fs::path obj = work / "obj-icarus";
   fs::create_directories(obj);
   const fs::path tb_file = obj / "ranging_icarus_tb.v";
-  const std::string cmd = "cd " + quote((work / "ip").string()) + " && iverilog -g2012 -o " +
-                          quote((obj / "sim").string()) + " -s ranging_icarus_tb -f files.f " + quote(tb_file.string());
+  const std::string cmd = "cd " + shell_quote((work / "ip").string()) + " && iverilog -g2012 -o " +
+                          shell_quote((obj / "sim").string()) + " -s ranging_icarus_tb -f files.f " + shell_quote(tb_file.string());
   std::uint64_t key = fnv1a(cmd + tb.str());
   std::istringstream list(read(work / "ip/files.f"));
   for (std::string line; std::getline(list, line);) key = fnv1a(read(work / "ip" / line), key);
@@ -317,7 +313,7 @@ void RtlReceiver::build_icarus(const fs::path& work) {
   if (fs::exists(driver_) && read(stamp_file) == std::to_string(key)) return;
   std::ofstream(tb_file) << tb.str();
   const fs::path log = work / "build-icarus.log";
-  const int rc = shell(cmd + " > " + quote(log.string()) + " 2>&1");
+  const int rc = shell(cmd + " > " + shell_quote(log.string()) + " 2>&1");
   if (rc != 0 || !fs::exists(driver_)) {
     throw InputError(opt_.rtl_option + ": Icarus does not compile the RTL in " + opt_.rtl_dir + "; log: " + log.string());
   }
@@ -336,14 +332,14 @@ void RtlReceiver::build_hls(const fs::path& work) {
   const fs::path obj = work / "obj-hls";
   fs::create_directories(obj);
   driver_ = obj / "hls_driver";
-  const std::string cmd = quote(cxx) + " -std=c++20 -O2 -I " + quote((work / "ip").string()) + " -o " +
-                          quote(driver_.string()) + " " + quote(driver_src.string());
+  const std::string cmd = shell_quote(cxx) + " -std=c++20 -O2 -I " + shell_quote((work / "ip").string()) + " -o " +
+                          shell_quote(driver_.string()) + " " + shell_quote(driver_src.string());
   std::uint64_t key = fnv1a(cmd + read(driver_src));
   for (const auto& e : fs::directory_iterator(work / "ip/hls")) key = fnv1a(read(e.path()), key);
   const fs::path stamp_file = obj / ".ranging-stamp";
   if (fs::exists(driver_) && read(stamp_file) == std::to_string(key)) return;
   const fs::path log = work / "build-hls.log";
-  if (shell(cmd + " > " + quote(log.string()) + " 2>&1") != 0 || !fs::exists(driver_)) {
+  if (shell(cmd + " > " + shell_quote(log.string()) + " 2>&1") != 0 || !fs::exists(driver_)) {
     throw InputError("the HLS C++ of this configuration does not compile (" + cxx + "); log: " + log.string());
   }
   std::ofstream(stamp_file) << key;
@@ -373,12 +369,12 @@ std::vector<RtlResult> RtlReceiver::run(const std::vector<RtlStimulus>& stimuli)
     }
     if (!f) throw InputError("cannot write " + stim.string());
   }
-  std::string env = "RANGING_TRACE_DIR=" + quote(opt_.work_dir.string()) + " ";
+  std::string env = "RANGING_TRACE_DIR=" + shell_quote(opt_.work_dir.string()) + " ";
   if (opt_.trace) env += "RANGING_TRACE=1 ";
   const std::string run_cmd = opt_.simulator == "icarus"
-                                  ? "vvp -n " + quote(driver_.string()) + " +stim=" + quote(stim.string()) + " +out=" +
-                                        quote(out.string()) + " > " + quote((dir / "vvp.log").string()) + " 2>&1"
-                                  : env + quote(driver_.string()) + " " + quote(stim.string()) + " " + quote(out.string());
+                                  ? "vvp -n " + shell_quote(driver_.string()) + " +stim=" + shell_quote(stim.string()) + " +out=" +
+                                        shell_quote(out.string()) + " > " + shell_quote((dir / "vvp.log").string()) + " 2>&1"
+                                  : env + shell_quote(driver_.string()) + " " + shell_quote(stim.string()) + " " + shell_quote(out.string());
   const int rc = shell(run_cmd);
   if (rc != 0) throw std::runtime_error("the Verilated driver failed (status " + std::to_string(rc) + ")");
 
