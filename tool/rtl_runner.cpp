@@ -1,7 +1,12 @@
 #include "tool/rtl_runner.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <cctype>
 #include <cmath>
@@ -121,6 +126,10 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
   std::error_code ec;
   fs::create_directories(work, ec);
   if (ec) throw InputError("--out: cannot create " + work.string() + ": " + ec.message());
+  lock_.fd = ::open((work / ".lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+  if (lock_.fd < 0 || ::flock(lock_.fd, LOCK_EX) != 0) {
+    throw InputError("--out: cannot lock " + (work / ".lock").string() + ": " + std::strerror(errno));
+  }
 
   // 1. The IP folder of this configuration (the user's RTL when --rtl is given).
   auto files = generate_hardware_files(design, opt_.origin);
@@ -344,6 +353,10 @@ void RtlReceiver::build_hls(const fs::path& work) {
   }
   std::ofstream(stamp_file) << key;
   rebuilt_ = true;
+}
+
+RtlReceiver::Lock::~Lock() {
+  if (fd >= 0) ::close(fd);  // releases the flock
 }
 
 std::vector<RtlResult> RtlReceiver::run(const std::vector<RtlStimulus>& stimuli) const {

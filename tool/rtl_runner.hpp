@@ -72,7 +72,11 @@ class RtlReceiver {
  public:
   // Generates and builds (progress on stderr unless quiet). Throws InputError when the
   // sources do not build (the message names the log).
+  // The work folder is locked (flock on WORK/.lock) from here to destruction: two processes
+  // on the same folder (two simulates of one configuration, parallel tests) take turns.
   RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& options);
+  RtlReceiver(const RtlReceiver&) = delete;
+  RtlReceiver& operator=(const RtlReceiver&) = delete;
   std::vector<RtlResult> run(const std::vector<RtlStimulus>& stimuli) const;
   const std::filesystem::path& work_dir() const { return opt_.work_dir; }
   double build_seconds() const { return build_seconds_; }
@@ -86,6 +90,13 @@ class RtlReceiver {
   std::filesystem::path driver_;
   double build_seconds_ = 0;
   bool rebuilt_ = false;
+  struct Lock {  // the flock's descriptor, closed (and so released) even if the constructor throws
+    int fd = -1;
+    Lock() = default;
+    Lock(const Lock&) = delete;
+    Lock& operator=(const Lock&) = delete;
+    ~Lock();
+  } lock_;
   int data_w_, sections_, chip_w_, corr_w_, time_w_, code_w_, frac_w_, score_w_, in_w_;
 };
 
