@@ -150,26 +150,34 @@ TEST(SimulateRtl, SceneEventsThroughTheRtlEqualTheFixedModels) {
   EXPECT_NE(bad.err.find("--rtl"), std::string::npos) << bad.err;
 }
 
-// The same scene through the iCE40 gate-level netlist (yosys synth_ice40 -dsp, Verilated with
-// yosys' cell models): the post-synthesis rung of the fidelity ladder, events identical too.
-TEST(SimulateRtl, SceneEventsThroughThePostSynthesisNetlistEqualTheFixedModels) {
-  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
-  const auto fixed = run_tool("simulate " + scene + " --precision fixed --quiet --out " + (scratch() / "fixed-ps").string());
+// A scene through one rung of the fidelity ladder (`--rtl-simulator LEVEL`): every stream also
+// runs through that level, its events must equal the fixed model's, so the measurements are
+// byte-identical to --precision fixed.
+static void expect_level_equals_fixed(const std::string& level, const fs::path& scene) {
+  const fs::path fixed_dir = scratch() / ("fixed-" + level), dir = scratch() / level;
+  const auto fixed = run_tool("simulate " + scene.string() + " --precision fixed --quiet --out " + fixed_dir.string());
   ASSERT_EQ(fixed.status, 0) << fixed.err;
-  const auto r = run_tool("simulate " + scene + " --precision rtl --rtl-simulator postsynth --json --quiet --out " +
-                          (scratch() / "postsynth").string());
+  const auto r = run_tool("simulate " + scene.string() + " --precision rtl --rtl-simulator " + level +
+                          " --json --quiet --out " + dir.string());
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   const auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j["rtl"]["simulator"], "postsynth");
+  EXPECT_EQ(j["rtl"]["simulator"], level);
   EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
   EXPECT_EQ(j["rtl"]["mismatches"], 0);
   EXPECT_GT(j["rtl"]["streams"].get<int>(), 0);
+  EXPECT_GE(j["rtl"]["events_compared"].get<int>(), j["rtl"]["streams"].get<int>());
   auto read = [](const fs::path& p) {
     std::stringstream ss;
     ss << std::ifstream(p).rdbuf();
     return ss.str();
   };
-  EXPECT_EQ(read(scratch() / "postsynth/measurements.csv"), read(scratch() / "fixed-ps/measurements.csv"));
+  EXPECT_EQ(read(dir / "measurements.csv"), read(fixed_dir / "measurements.csv"));
+}
+
+// The iCE40 gate-level netlist (yosys synth_ice40 -dsp, Verilated with yosys' cell models).
+TEST(SimulateRtl, SceneEventsThroughThePostSynthesisNetlistEqualTheFixedModels) {
+  expect_level_equals_fixed("postsynth", kRoot / "scenes/minimal.yaml");
+  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
   for (const std::string bad : {" --precision rtl --rtl-simulator questa", " --precision fixed --rtl-simulator postsynth"}) {
     const auto b = run_tool("simulate " + scene + bad + " --out " + (scratch() / "bad-ps").string());
     EXPECT_EQ(b.status, 2) << bad;
@@ -179,44 +187,22 @@ TEST(SimulateRtl, SceneEventsThroughThePostSynthesisNetlistEqualTheFixedModels) 
   }
 }
 
-// The same through Icarus Verilog (a generated testbench, the Verilog twin of verify_driver):
-// one code at one distance (Icarus is slow), events identical to the fixed model's.
+// Icarus Verilog (a generated testbench, the Verilog twin of verify_driver): one code at one
+// distance, Icarus is slow.
 TEST(SimulateRtl, SceneEventsThroughIcarusEqualTheFixedModels) {
   const fs::path scene = scratch() / "one-code.yaml";
   std::ofstream(scene) << "geometry:\n  distances_m: [0.5]\nexcitation:\n  family: Gold4\n  codes: [2]\n";
-  const auto fixed = run_tool("simulate " + scene.string() + " --precision fixed --quiet --out " + (scratch() / "fixed-ic").string());
-  ASSERT_EQ(fixed.status, 0) << fixed.err;
-  const auto r = run_tool("simulate " + scene.string() + " --precision rtl --rtl-simulator icarus --json --quiet --out " +
-                          (scratch() / "icarus").string());
-  ASSERT_EQ(r.status, 0) << r.err << r.out;
-  const auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j["rtl"]["simulator"], "icarus");
-  EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
-  EXPECT_EQ(j["rtl"]["mismatches"], 0);
-  EXPECT_GE(j["rtl"]["events_compared"].get<int>(), 2);
-  std::stringstream a, b;
-  a << std::ifstream(scratch() / "icarus/measurements.csv").rdbuf();
-  b << std::ifstream(scratch() / "fixed-ic/measurements.csv").rdbuf();
-  EXPECT_EQ(a.str(), b.str());
+  expect_level_equals_fixed("icarus", scene);
 }
 
-// The HLS C++ (C simulation, compiled at run time against the IP folder's configuration):
-// the scene's events equal the fixed model's.
+// The HLS C++ (C simulation, compiled at run time against the IP folder's configuration).
 TEST(SimulateRtl, SceneEventsThroughTheHlsCSimulationEqualTheFixedModels) {
-  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
-  const auto fixed = run_tool("simulate " + scene + " --precision fixed --quiet --out " + (scratch() / "fixed-hls").string());
-  ASSERT_EQ(fixed.status, 0) << fixed.err;
-  const auto r = run_tool("simulate " + scene + " --precision rtl --rtl-simulator hls --json --quiet --out " +
-                          (scratch() / "hls").string());
-  ASSERT_EQ(r.status, 0) << r.err << r.out;
-  const auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j["rtl"]["simulator"], "hls");
-  EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
-  EXPECT_GT(j["rtl"]["events_compared"].get<int>(), 0);
-  std::stringstream a, b;
-  a << std::ifstream(scratch() / "hls/measurements.csv").rdbuf();
-  b << std::ifstream(scratch() / "fixed-hls/measurements.csv").rdbuf();
-  EXPECT_EQ(a.str(), b.str());
+  expect_level_equals_fixed("hls", kRoot / "scenes/minimal.yaml");
+}
+
+// The RTL Verilated as an SC_MODULE (verilator --sc), driven under the SystemC kernel.
+TEST(SimulateRtl, SceneEventsThroughSystemCEqualTheFixedModels) {
+  expect_level_equals_fixed("systemc", kRoot / "scenes/minimal.yaml");
 }
 
 // The real-time rule (model/hw/realtime.hpp) against the RTL on a sample of design points:
@@ -246,23 +232,4 @@ TEST(Verify, TheRealTimeRuleAgreesWithThePacedRtl) {
     EXPECT_EQ(rt["late_samples"].get<int>() == 0, pt.real_time) << rt.dump();
     EXPECT_EQ(r.status, 0) << r.err;  // a NOT REAL TIME design the RTL confirms is no failure of verify
   }
-}
-
-// The RTL Verilated as an SC_MODULE (verilator --sc) and driven under the SystemC kernel
-// (tb/verify_driver_sc.cpp): the scene's events equal the fixed model's.
-TEST(SimulateRtl, SceneEventsThroughSystemCEqualTheFixedModels) {
-  const std::string scene = (kRoot / "scenes/minimal.yaml").string();
-  const auto fixed = run_tool("simulate " + scene + " --precision fixed --quiet --out " + (scratch() / "fixed-sc").string());
-  ASSERT_EQ(fixed.status, 0) << fixed.err;
-  const auto r = run_tool("simulate " + scene + " --precision rtl --rtl-simulator systemc --json --quiet --out " +
-                          (scratch() / "systemc").string());
-  ASSERT_EQ(r.status, 0) << r.err << r.out;
-  const auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j["rtl"]["simulator"], "systemc");
-  EXPECT_TRUE(j["rtl"]["pass"].get<bool>());
-  EXPECT_GT(j["rtl"]["events_compared"].get<int>(), 0);
-  std::stringstream a, b;
-  a << std::ifstream(scratch() / "systemc/measurements.csv").rdbuf();
-  b << std::ifstream(scratch() / "fixed-sc/measurements.csv").rdbuf();
-  EXPECT_EQ(a.str(), b.str());
 }
