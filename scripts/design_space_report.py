@@ -5,7 +5,8 @@ chosen points (scripts/design_space_synth.sh, one JSON object a line).
 
   scripts/design_space_report.py SWEEP.json WORDLENGTH.json SYNTH.jsonl OUT_PREFIX [SECONDS]
 
-SECONDS: the sweep's wall time, for points per hour. Accuracy tolerance for "the default's
+SECONDS: the sweep's wall time, for points per hour; POINTS:SECONDS when only POINTS of them were
+timed (a resumed run's last leg). Accuracy tolerance for "the default's
 accuracy": no decode error and RMSE <= 1.1 x the default's (as ranging wordlength)."""
 import json
 import math
@@ -29,7 +30,7 @@ def params(p):
     return ", ".join(f"{k}={v}" for k, v in sorted(p["params"].items())) or "(default)"
 
 
-def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
+def main(sweep_path, wl_path, synth_path, prefix, seconds=None, timed_points=None):
     doc = json.load(open(sweep_path))
     wl = json.load(open(wl_path))
     synth = [json.loads(line) for line in open(synth_path) if line.strip()]
@@ -77,7 +78,8 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
            "dominated_by": dominators[:3], "as_accurate_as_default": as_good[:10],
            "synthesis": [dict(s, channels={"up5k": channels(s)[0], "ecp5_25f": channels(s)[1]}) for s in synth],
            "wordlength": wl, "sweep_seconds": seconds,
-           "points_per_hour": (len(pts) * 3600.0 / seconds) if seconds else None}
+           "points_per_hour": ((timed_points or len(pts)) * 3600.0 / seconds) if seconds else None,
+           "timed_points": timed_points or len(pts)}
     json.dump(out, open(prefix + ".json", "w"), indent=1)
 
     fig, axs = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -128,8 +130,11 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
                  "without synthesis (`--no-synth`). The iCE40/ECP5 figures are measured by yosys for the points in "
                  "the synthesis table only. Real time: the design's rule (model/hw/realtime.hpp).\n")
     if seconds:
-        L.append(f"Speed: {len(pts)} points in {seconds:.0f} s wall with `--jobs 2` on the shared 2-core machine: "
-                 f"**{len(pts) * 3600.0 / seconds:.0f} points per hour** "
+        tp = timed_points or len(pts)
+        L.append(f"Speed: {tp} points in {seconds:.0f} s wall with `--jobs 2` on the shared 2-core machine"
+                 + (" (the last leg of the resumed run; the points before it were evaluated by earlier legs and kept)"
+                    if tp != len(pts) else "") + ": "
+                 f"**{tp * 3600.0 / seconds:.0f} points per hour** "
                  + ("with synthesis (every distinct RTL through yosys for each target)" if cname == "lut4" else
                     "without synthesis") + ".\n")
     hdr = (f"| id | params | {cshort} | MAC16 | EBR | ECP5 LUT4 / MULT18 | word_bits | errors (wrong/missed/false) | RMSE mm | "
@@ -252,4 +257,6 @@ def main(sweep_path, wl_path, synth_path, prefix, seconds=None):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], float(sys.argv[5]) if len(sys.argv) > 5 else None)
+    t = sys.argv[5].split(":") if len(sys.argv) > 5 else None
+    main(sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], float(t[-1]) if t else None,
+         int(t[0]) if t and len(t) == 2 else None)
