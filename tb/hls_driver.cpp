@@ -12,6 +12,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "driver_stimulus.hpp"  // next to this file
+
 #include "hls/receiver_config.hpp"
 #include "hls/receiver_hls.hpp"
 
@@ -29,23 +31,15 @@ int main(int argc, char** argv) {
   using Cfg = ranging_hls::ReceiverConfig;
   constexpr int in_w = static_cast<int>(Cfg::SOS_IN_W);
   static ranging_hls::Receiver<Cfg> rx;  // static: large state
-  char name[256];
-  double valid_prob, ready_prob;
-  unsigned long long seed, quiet, n, cadence;  // cadence: unused (no clock in C simulation)
-  long long reset_at;
-  while (std::fscanf(in, " run %255s %lf %lf %llu %lld %llu %llu %llu", name, &valid_prob, &ready_prob, &seed,
-                     &reset_at, &quiet, &n, &cadence) == 8) {
-    std::vector<std::int64_t> x(n);
-    for (auto& v : x) {
-      std::uint64_t u = 0;
-      if (std::fscanf(in, "%" SCNu64, &u) != 1) {
-        std::fprintf(stderr, "hls_driver: run %s: short sample list\n", name);
-        return 2;
-      }
-      // Sign-extend the IN_W-bit port value.
-      const std::uint64_t m = std::uint64_t{1} << (in_w - 1);
-      v = static_cast<std::int64_t>(u ^ m) - static_cast<std::int64_t>(m);
-    }
+  ranging::tb::DriverRun run;
+  int got = 0;
+  while ((got = ranging::tb::read_run(in, run)) > 0) {
+    const char* name = run.name.c_str();
+    const long long reset_at = run.reset_at;
+    // Sign-extend the IN_W-bit port values.
+    std::vector<std::int64_t> x;
+    const std::uint64_t m = std::uint64_t{1} << (in_w - 1);
+    for (std::uint64_t u : run.x) x.push_back(static_cast<std::int64_t>(u ^ m) - static_cast<std::int64_t>(m));
     std::fprintf(out, "run %s\n", name);
     rx.reset();
     ranging_hls::EventBeat ev;
@@ -62,5 +56,9 @@ int main(int argc, char** argv) {
   }
   std::fclose(out);
   std::fclose(in);
+  if (got < 0) {
+    std::fprintf(stderr, "hls_driver: run %s: short sample list\n", run.name.c_str());
+    return 2;
+  }
   return 0;
 }

@@ -44,6 +44,12 @@ struct Cleanup : ::testing::Environment {
 };
 const auto* const g_cleanup = ::testing::AddGlobalTestEnvironment(new Cleanup);
 
+std::string read(const fs::path& p) {
+  std::stringstream ss;
+  ss << std::ifstream(p).rdbuf();
+  return ss.str();
+}
+
 nlohmann::json stage(const nlohmann::json& j, const std::string& name) {
   for (const auto& s : j["stages"]) {
     if (s["name"] == name) return s;
@@ -138,11 +144,6 @@ TEST(SimulateRtl, SceneEventsThroughTheRtlEqualTheFixedModels) {
   EXPECT_EQ(j["rtl"]["mismatches"], 0);
   EXPECT_GT(j["rtl"]["streams"].get<int>(), 0);
   EXPECT_GE(j["rtl"]["events_compared"].get<int>(), j["rtl"]["streams"].get<int>());
-  auto read = [](const fs::path& p) {
-    std::stringstream ss;
-    ss << std::ifstream(p).rdbuf();
-    return ss.str();
-  };
   EXPECT_EQ(read(scratch() / "rtl/measurements.csv"), read(scratch() / "fixed/measurements.csv"));
   const auto bad = run_tool("simulate " + scene + " --precision float --rtl " + (kRoot / "rtl").string() + " --out " +
                             (scratch() / "bad").string());
@@ -166,11 +167,6 @@ static void expect_level_equals_fixed(const std::string& level, const fs::path& 
   EXPECT_EQ(j["rtl"]["mismatches"], 0);
   EXPECT_GT(j["rtl"]["streams"].get<int>(), 0);
   EXPECT_GE(j["rtl"]["events_compared"].get<int>(), j["rtl"]["streams"].get<int>());
-  auto read = [](const fs::path& p) {
-    std::stringstream ss;
-    ss << std::ifstream(p).rdbuf();
-    return ss.str();
-  };
   EXPECT_EQ(read(dir / "measurements.csv"), read(fixed_dir / "measurements.csv"));
 }
 

@@ -31,8 +31,10 @@
 #include <random>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "Vreceiver_top.h"
+#include "driver_stimulus.hpp"    // next to this file: the stimulus reader
 #include "verilator_harness.hpp"  // next to this file: the shared harness
 
 namespace {
@@ -69,19 +71,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "verify_driver: cannot open %s or %s\n", argv[1], argv[2]);
     return 2;
   }
-  char name[256];
-  double valid_prob, ready_prob;
-  unsigned long long seed, quiet, n, cadence;
-  long long reset_at;
-  while (std::fscanf(in, " run %255s %lf %lf %llu %lld %llu %llu %llu", name, &valid_prob, &ready_prob, &seed,
-                     &reset_at, &quiet, &n, &cadence) == 8) {
-    std::vector<std::uint64_t> x(n);
-    for (auto& v : x) {
-      if (std::fscanf(in, "%" SCNu64, &v) != 1) {
-        std::fprintf(stderr, "verify_driver: run %s: short sample list\n", name);
-        return 2;
-      }
-    }
+  ranging::tb::DriverRun run;
+  int got = 0;
+  while ((got = ranging::tb::read_run(in, run)) > 0) {
+    const char* name = run.name.c_str();
+    const double valid_prob = run.valid_prob, ready_prob = run.ready_prob;
+    const unsigned long long seed = run.seed, quiet = run.quiet, cadence = run.cadence;
+    long long reset_at = run.reset_at;
+    const std::vector<std::uint64_t>& x = run.x;
     std::fprintf(out, "run %s\n", name);
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -151,5 +148,9 @@ int main(int argc, char** argv) {
   }
   std::fclose(out);
   std::fclose(in);
+  if (got < 0) {
+    std::fprintf(stderr, "verify_driver: run %s: short sample list\n", run.name.c_str());
+    return 2;
+  }
   return 0;
 }

@@ -14,6 +14,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "driver_stimulus.hpp"  // next to this file
+
 #include "Vreceiver_top.h"
 
 namespace {
@@ -95,19 +97,14 @@ int sc_main(int argc, char** argv) {
     rst.write(false);
     sc_core::sc_start(1, SC_NS);
   };
-  char name[256];
-  double valid_prob, ready_prob;
-  unsigned long long seed, quiet, n, cadence;
-  long long reset_at;
-  while (std::fscanf(in, " run %255s %lf %lf %llu %lld %llu %llu %llu", name, &valid_prob, &ready_prob, &seed,
-                     &reset_at, &quiet, &n, &cadence) == 8) {
-    std::vector<std::uint64_t> x(n);
-    for (auto& v : x) {
-      if (std::fscanf(in, "%" SCNu64, &v) != 1) {
-        std::fprintf(stderr, "verify_driver_sc: run %s: short sample list\n", name);
-        return 2;
-      }
-    }
+  ranging::tb::DriverRun run;
+  int got = 0;
+  while ((got = ranging::tb::read_run(in, run)) > 0) {
+    const char* name = run.name.c_str();
+    const double valid_prob = run.valid_prob, ready_prob = run.ready_prob;
+    const unsigned long long seed = run.seed, quiet = run.quiet, cadence = run.cadence;
+    long long reset_at = run.reset_at;
+    const std::vector<std::uint64_t>& x = run.x;
     std::fprintf(out, "run %s\n", name);
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -177,5 +174,9 @@ int sc_main(int argc, char** argv) {
   }
   std::fclose(out);
   std::fclose(in);
+  if (got < 0) {
+    std::fprintf(stderr, "verify_driver_sc: run %s: short sample list\n", run.name.c_str());
+    return 2;
+  }
   return 0;
 }

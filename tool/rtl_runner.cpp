@@ -211,7 +211,9 @@ RtlReceiver::RtlReceiver(const ReceiverDesign& design, const RtlBuildOptions& op
                           " --top-module receiver_top --Mdir " + shell_quote(obj.string()) +
                           " -o verify_driver " + shell_quote(driver_src.string());
   std::uint64_t key = fnv1a(netlist_cmd + cmd + read(driver_src));
-  for (const char* h : {"tb/verilator_harness.hpp", "tb/bits.hpp"}) key = fnv1a(read(fs::path(src) / h), key);
+  for (const char* h : {"tb/verilator_harness.hpp", "tb/bits.hpp", "tb/driver_stimulus.hpp"}) {
+    key = fnv1a(read(fs::path(src) / h), key);
+  }
   std::istringstream list(read(work / "ip/files.f"));
   for (std::string line; std::getline(list, line);) key = fnv1a(read(work / "ip" / line), key);
   const std::string stamp = std::to_string(key);
@@ -343,7 +345,7 @@ void RtlReceiver::build_hls(const fs::path& work) {
   driver_ = obj / "hls_driver";
   const std::string cmd = shell_quote(cxx) + " -std=c++20 -O2 -I " + shell_quote((work / "ip").string()) + " -o " +
                           shell_quote(driver_.string()) + " " + shell_quote(driver_src.string());
-  std::uint64_t key = fnv1a(cmd + read(driver_src));
+  std::uint64_t key = fnv1a(cmd + read(driver_src) + read(fs::path(src) / "tb/driver_stimulus.hpp"));
   for (const auto& e : fs::directory_iterator(work / "ip/hls")) key = fnv1a(read(e.path()), key);
   const fs::path stamp_file = obj / ".ranging-stamp";
   if (fs::exists(driver_) && read(stamp_file) == std::to_string(key)) return;

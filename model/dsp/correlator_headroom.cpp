@@ -125,9 +125,12 @@ double tap_l1(const CorrelatorFixedLayout& l) {
 
 }  // namespace
 
-std::vector<std::int64_t> correlator_worst_case(const CorrelatorReference& ref, const CorrelatorFixedConfig& cfg,
-                                                BankNode node, int code, bool imag, bool negate) {
-  const CorrelatorFixedLayout l = resolve_correlator_layout(ref, cfg);
+namespace {
+
+// The worst case of a node from a resolved layout and its linearization (correlator_headroom
+// drives dozens of them from one of each).
+std::vector<std::int64_t> worst_case(const CorrelatorFixedLayout& l, const Linearized& lin, int data_bits, BankNode node,
+                                     int code, bool imag, bool negate) {
   if (node == BankNode::Power || node == BankNode::Weighted) {
     throw InputError("correlator_worst_case: P_j and Q_j take the C_q worst case (BankNode::CorrQ)");
   }
@@ -136,13 +139,21 @@ std::vector<std::int64_t> correlator_worst_case(const CorrelatorReference& ref, 
                      std::to_string(l.codes - 1) + "]");
   }
   if (node == BankNode::Energy) {
-    const std::int64_t bottom = -(std::int64_t{1} << (cfg.data_bits - 1));
+    const std::int64_t bottom = -(std::int64_t{1} << (data_bits - 1));
+    const auto d = static_cast<std::size_t>(l.decimation);
     std::size_t n = static_cast<std::size_t>(l.window);
-    n += (static_cast<std::size_t>(l.decimation) - n % static_cast<std::size_t>(l.decimation)) % static_cast<std::size_t>(l.decimation);
+    n += (d - n % d) % d;
     return std::vector<std::int64_t>(n, negate ? -bottom - 1 : bottom);
   }
-  const Linearized lin(ref, l);
-  return sign_sequence(lin.worst(node, code, imag), cfg.data_bits, negate);
+  return sign_sequence(lin.worst(node, code, imag), data_bits, negate);
+}
+
+}  // namespace
+
+std::vector<std::int64_t> correlator_worst_case(const CorrelatorReference& ref, const CorrelatorFixedConfig& cfg,
+                                                BankNode node, int code, bool imag, bool negate) {
+  const CorrelatorFixedLayout l = resolve_correlator_layout(ref, cfg);
+  return worst_case(l, Linearized(ref, l), cfg.data_bits, node, code, imag, negate);
 }
 
 std::vector<BankNodeHeadroom> correlator_headroom(const CorrelatorReference& ref, const CorrelatorFixedConfig& cfg) {
@@ -222,7 +233,7 @@ std::vector<BankNodeHeadroom> correlator_headroom(const CorrelatorReference& ref
     if (h.exact && std::abs(v) > h.limit) ++h.overflows;
   };
   auto run = [&](BankNode n, int code, bool im, bool neg) {
-    const std::vector<std::int64_t> y = correlator_worst_case(ref, cfg, n, code, im, neg);
+    const std::vector<std::int64_t> y = worst_case(l, lin, cfg.data_bits, n, code, im, neg);
     CorrelatorBankFixed bank(ref, cfg);
     for (std::int64_t v : y) {
       const bool out_ready = bank.execute(v);
