@@ -9,6 +9,7 @@
 #include "model/sim/channel.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
+#include "model/dsp/latency.hpp"
 #include "model/hw/hw_emit.hpp"
 #include "model/hw/hw_params.hpp"
 
@@ -123,42 +124,44 @@ SystemDesign system_design(const ReceiverDesign& d, const SystemOptions& options
   s.c_init = speed_register(opt.speed_of_sound, c.fs, s.c_frac);
   s.led_hold = static_cast<std::int64_t>(opt.clk_hz / 20);
 
-  // Latency calibration on the golden model: the arrival the fixed receiver reports for a
-  // burst sent at sample 0 through the reference transducers, minus the true flight.
-  ExcitationParams ex;
-  ex.carrier_hz = c.carrier_hz;
-  ex.cycles_per_chip = c.cycles_per_chip;
-  ex.fs = c.fs;
+  // Latency calibration on the golden model (model/dsp/latency.hpp): the arrival of the
+  // strongest event the fixed receiver reports for a burst sent at sample 0 through the
+  // reference transducers, minus the true flight, in frac_w fraction bits.
+  const ExcitationParams ex = receiver_excitation(c);
   ChannelParams ch;
   ch.speed_of_sound = opt.speed_of_sound;
   ch.distance_m = opt.calibration_distance_m;
   ch.gain = 0.5;
   ch.tx = c.reference_transducer;
   ch.rx = c.reference_transducer;
-  const double flight = opt.calibration_distance_m / opt.speed_of_sound * c.fs;
+  const double flight = calibration_flight(opt.calibration_distance_m, opt.speed_of_sound, c.fs);
   const std::int64_t flight_q = std::llround(std::ldexp(flight, s.frac_w));
   const std::size_t n_out = static_cast<std::size_t>(flight) + burst + 3 * d.layout.window + 2000;
-  for (int j = 0; j < s.codes; ++j) {
-    const auto drive = hbridge_drive(d.family.codes[static_cast<std::size_t>(j)], ex);
-    const std::vector<double> x(drive.begin(), drive.end());
-    const auto y = propagate(x, ch, c.fs, n_out);
-    ReceiverFixed rx(d);
-    std::optional<EventFixed> ev;
-    for (double v : y) {
-      if (auto e = rx.execute_raw(quantize_input(v, c.bandpass.input_bits, nullptr)); e && !ev) ev = e;
-    }
-    if (!ev) ev = rx.flush_raw();
-    if (!ev || ev->code != j + 1) {
-      throw InputError("system.calibration_distance_m: code " + std::to_string(j + 1) +
-                       " is not decoded at the calibration distance; check detector.threshold");
-    }
-    const std::int64_t off = ev->arrival - flight_q;
-    const std::int64_t lim = std::int64_t{1} << (s.off_w - 1);
+  s.offsets = calibrate_receiver_latency<EventFixed>(
+      static_cast<std::size_t>(s.codes), flight_q,
+      [&](int code) {
+        const auto drive = hbridge_drive(d.family.codes[static_cast<std::size_t>(code - 1)], ex);
+        const std::vector<double> x(drive.begin(), drive.end());
+        const auto y = propagate(x, ch, c.fs, n_out);
+        ReceiverFixed rx(d);
+        std::vector<EventFixed> events;
+        for (double v : y) {
+          if (auto e = rx.execute_raw(quantize_input(v, c.bandpass.input_bits, nullptr))) events.push_back(*e);
+        }
+        if (auto e = rx.flush_raw()) events.push_back(*e);
+        return events;
+      },
+      [](int code) {
+        return "system.calibration_distance_m: code " + std::to_string(code) +
+               " is not decoded at the calibration distance; check detector.threshold";
+      });
+  const std::int64_t lim = std::int64_t{1} << (s.off_w - 1);
+  for (std::size_t j = 0; j < s.offsets.size(); ++j) {
+    const std::int64_t off = s.offsets[j];
     if (off < -lim || off >= lim) {
       throw InputError("system.off_w: the latency offset " + std::to_string(off) + " of code " + std::to_string(j + 1) +
                        " does not fit " + std::to_string(s.off_w) + " signed bits; valid range is [16, 48]");
     }
-    s.offsets.push_back(off);
   }
   return s;
 }

@@ -5,6 +5,7 @@
 
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
+#include "model/dsp/latency.hpp"
 #include "model/sim/metrics.hpp"
 
 namespace ranging {
@@ -72,26 +73,35 @@ std::vector<DemoRow> run_demo(const DemoParams& p,
   const std::size_t total = eta * (p.distances_m.size() + 1);
   std::size_t done = 0;
 
-  // Calibration: noise-free burst of every code at the reference distance.
-  std::vector<double> offset_flt(eta, 0), offset_fix(eta, 0);
+  // Calibration: noise-free burst of every code at the reference distance, through both
+  // receivers at once (the fixed receiver's pass is kept for the float one's offsets).
+  const double cal_delay = calibration_flight(kCalibrationDistance, p.speed_of_sound, rc.fs);
+  std::vector<Pass> cal(eta);
+  auto events = [](const std::optional<Event>& e) { return e ? std::vector<Event>{*e} : std::vector<Event>{}; };
+  auto failure = [](int code) {
+    return "calibration: code " + std::to_string(code) +
+           " was not decoded at the reference distance; lower detector.threshold or raise --gain";
+  };
+  const std::vector<double> offset_fix = calibrate_receiver_latency<Event>(
+      eta, cal_delay,
+      [&](int code) {
+        const auto exc = bpsk_excitation(design.family.codes[static_cast<std::size_t>(code - 1)], ex);
+        const auto rx = propagate(exc, channel_for(p, kCalibrationDistance, 0.0, p.seed), rc.fs,
+                                  static_cast<std::size_t>(cal_delay) + tail);
+        Pass& pass = cal[static_cast<std::size_t>(code - 1)];
+        pass = run_receivers(design, rx);
+        if (progress) progress(++done, total);
+        return events(pass.fix);
+      },
+      failure);
+  const std::vector<double> offset_flt = calibrate_receiver_latency<Event>(
+      eta, cal_delay, [&](int code) { return events(cal[static_cast<std::size_t>(code - 1)].flt); }, failure);
   std::vector<std::vector<double>> templates(eta);
-  const double cal_delay = kCalibrationDistance / p.speed_of_sound * rc.fs;
   for (std::size_t j = 0; j < eta; ++j) {
-    const auto exc = bpsk_excitation(design.family.codes[j], ex);
-    const auto rx = propagate(exc, channel_for(p, kCalibrationDistance, 0.0, p.seed),
-                              rc.fs, static_cast<std::size_t>(cal_delay) + tail);
-    Pass pass = run_receivers(design, rx);
-    if (!pass.flt || !pass.fix) {
-      throw InputError("calibration: code " + std::to_string(j + 1) +
-                       " was not detected at the reference distance; lower detector.threshold "
-                       "or raise --gain");
-    }
-    offset_flt[j] = pass.flt->arrival - cal_delay;
-    offset_fix[j] = pass.fix->arrival - cal_delay;
     const std::size_t start = static_cast<std::size_t>(std::lround(cal_delay));
-    templates[j].assign(pass.filtered.begin() + start, pass.filtered.begin() + start + template_len);
-    if (progress) progress(++done, total);
+    templates[j].assign(cal[j].filtered.begin() + start, cal[j].filtered.begin() + start + template_len);
   }
+  cal.clear();
 
   PearsonBank bank(templates);
   std::vector<DemoRow> rows;

@@ -18,6 +18,7 @@
 #include "model/sim/channel.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
+#include "model/dsp/latency.hpp"
 #include "model/sim/metrics.hpp"
 
 namespace ranging {
@@ -296,29 +297,29 @@ struct SceneSimulator::Link {
     const Scene& s = *scene;
     const double d = s.receiver.calibration_distance_m;
     const std::size_t eta = design.family.codes.size();
-    offset.assign(eta, 0.0);
+    const double delay = calibration_flight(d, c(), s.fs);
+    std::vector<std::vector<double>> filtered(eta);
+    offset = calibrate_receiver_latency<Event>(
+        eta, delay,
+        [&](int code) {
+          const Sparse& b = clean(code, d);
+          std::vector<double> x(static_cast<std::size_t>(std::max<long>(b.start, 0)) + b.y.size() + stream_tail(),
+                                0.0);
+          add_into(x, b, 0);
+          double peak = 0;
+          for (double v : x) peak = std::max(peak, std::abs(v));
+          // Calibrate at half full scale so the fixed receiver sees a healthy level.
+          return receive(x, peak / 0.5, filtered[static_cast<std::size_t>(code - 1)]);
+        },
+        [&](int code) {
+          return s.origin + ": calibration: code " + std::to_string(code) + " of " + family_name +
+                 " was not decoded on a noise-free burst at " + fmt(d) +
+                 " m; lower receiver.threshold or check the scene's stages";
+        });
     templates.assign(eta, {});
-    const double delay = d / c() * s.fs;
     for (std::size_t j = 0; j < eta; ++j) {
-      const Sparse& b = clean(static_cast<int>(j) + 1, d);
-      std::vector<double> x(static_cast<std::size_t>(std::max<long>(b.start, 0)) + b.y.size() + stream_tail(), 0.0);
-      add_into(x, b, 0);
-      double peak = 0;
-      for (double v : x) peak = std::max(peak, std::abs(v));
-      std::vector<double> f;
-      // Calibrate at half full scale so the fixed receiver sees a healthy level.
-      const auto ev = receive(x, peak / 0.5, f);
-      const Event* best = nullptr;
-      for (const auto& e : ev) {
-        if (!best || e.score > best->score) best = &e;
-      }
-      if (!best || best->code != static_cast<int>(j) + 1) {
-        throw InputError(s.origin + ": calibration: code " + std::to_string(j + 1) + " of " + family_name +
-                         " was not decoded on a noise-free burst at " + fmt(d) +
-                         " m; lower receiver.threshold or check the scene's stages");
-      }
-      offset[j] = best->arrival - delay;
       const std::size_t start = static_cast<std::size_t>(std::lround(delay));
+      const std::vector<double>& f = filtered[j];
       if (s.receiver.reference == "received") {
         templates[j].assign(f.begin() + static_cast<long>(start), f.begin() + static_cast<long>(start + template_len));
       } else if (s.receiver.reference == "ideal") {
@@ -365,11 +366,8 @@ struct SceneSimulator::Link {
     if (peak == 0.0) throw InputError(path + ": reference is all zero");
     x.resize(x.size() + stream_tail(), 0.0);
     std::vector<double> y;
-    const Event* best = nullptr;
     const auto ev = receive(x, peak / 0.5, y);
-    for (const auto& e : ev) {
-      if (!best || e.score > best->score) best = &e;
-    }
+    const Event* best = strongest_event(ev);
     if (!best) throw InputError(path + ": the receiver detects no " + family_name + " burst in this reference");
     const long k0 = std::lround(best->arrival - offset[static_cast<std::size_t>(best->code - 1)]);
     std::vector<double> t(template_len, 0.0);
