@@ -91,6 +91,18 @@ struct Burst {
   double tx_s = 0;     // transmission time
 };
 
+// What a decoded stream is matched against: with period_s > 0 the codes in order every period_s
+// up to `span` (seconds), else every code once at t = 0.
+std::vector<Burst> decode_schedule(int eta, double span, double period_s) {
+  std::vector<Burst> schedule;
+  if (period_s > 0) {
+    for (long k = 0; k * period_s <= span; ++k) schedule.push_back({static_cast<int>(k % eta) + 1, k * period_s});
+  } else {
+    for (int j = 1; j <= eta; ++j) schedule.push_back({j, 0.0});
+  }
+  return schedule;
+}
+
 }  // namespace
 
 std::vector<SceneStage> scene_stages(const Scene& s) {
@@ -826,14 +838,8 @@ std::vector<Detection> SceneSimulator::decode(const std::string& family, const s
   double peak = 0;
   for (double v : x) peak = std::max(peak, std::abs(v));
   if (peak == 0) return {};
-  std::vector<Burst> schedule;
-  const int eta = lk.design.family.eta();
-  const double span = t0 + static_cast<double>(x.size()) / scene_.fs;
-  if (period_s > 0) {
-    for (long k = 0; k * period_s <= span; ++k) schedule.push_back({static_cast<int>(k % eta) + 1, k * period_s});
-  } else {
-    for (int j = 1; j <= eta; ++j) schedule.push_back({j, 0.0});
-  }
+  const std::vector<Burst> schedule =
+      decode_schedule(lk.design.family.eta(), t0 + static_cast<double>(x.size()) / scene_.fs, period_s);
   std::vector<double> f;
   // The receiver sees the capture at half full scale at its peak; f comes back in capture units.
   const auto ev = lk.receive(x, peak / 0.5, f);
@@ -856,14 +862,8 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
   if (peak == 0) return {};
   const double t0 = src.t0();
   const long n = static_cast<long>(src.size());
-  std::vector<Burst> schedule;
-  const int eta = lk.design.family.eta();
-  const double span = t0 + static_cast<double>(src.size()) / scene_.fs;
-  if (period_s > 0) {
-    for (long k = 0; k * period_s <= span; ++k) schedule.push_back({static_cast<int>(k % eta) + 1, k * period_s});
-  } else {
-    for (int j = 1; j <= eta; ++j) schedule.push_back({j, 0.0});
-  }
+  const std::vector<Burst> schedule =
+      decode_schedule(lk.design.family.eta(), t0 + static_cast<double>(src.size()) / scene_.fs, period_s);
   const double scale = peak / 0.5;
   // Pass 2: the receiver's events.
   const auto ev = lk.receive_events(src, scale, block);
@@ -910,10 +910,8 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
 std::vector<Detection> SceneSimulator::receive_stream(const std::string& family, const std::vector<double>& x,
                                                       double t0, double period_s, std::uint64_t* overflows) {
   Link& lk = link(family);
-  const int eta = lk.design.family.eta();
-  const double span = t0 + static_cast<double>(x.size()) / scene_.fs;
-  std::vector<Burst> schedule;
-  for (long k = 0; k * period_s <= span; ++k) schedule.push_back({static_cast<int>(k % eta) + 1, k * period_s});
+  const std::vector<Burst> schedule =
+      decode_schedule(lk.design.family.eta(), t0 + static_cast<double>(x.size()) / scene_.fs, period_s);
   std::vector<double> f;
   lk.overflows = 0;
   const auto ev = lk.receive(x, lk.input_scale(), f);
