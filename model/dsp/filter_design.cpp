@@ -515,6 +515,23 @@ std::string filter_type_name(FilterType type) {
   return "?";
 }
 
+namespace {
+// Modified Bessel function I0 by its power series (converges fast for the betas used).
+double bessel_i0(double x) {
+  double sum = 1.0, term = 1.0;
+  const double q = x * x / 4.0;
+  for (int k = 1; k < 300 && term > 1e-17 * sum; ++k) {
+    term *= q / (static_cast<double>(k) * k);
+    sum += term;
+  }
+  return sum;
+}
+}  // namespace
+
+double kaiser_window(double r, double beta) {
+  return bessel_i0(beta * std::sqrt(std::max(0.0, 1.0 - r * r))) / bessel_i0(beta);
+}
+
 double pole_radius(const Biquad& s) {
   const cd disc = std::sqrt(cd(s.a1 * s.a1 - 4 * s.a2, 0));
   return std::max(std::abs((-s.a1 + disc) / 2.0), std::abs((-s.a1 - disc) / 2.0));

@@ -65,4 +65,8 @@ double pole_radius(const Biquad& section);  // max |pole| of the section
 // Attenuation -20*log10|H(f)| in dB (+inf at an exact zero).
 double attenuation_db(const SosFilter& filter, double f);
 
+// The Kaiser window at r in [-1, 1] (1 at r = 0): I0(beta sqrt(1 - r^2)) / I0(beta), I0 by its
+// power series (the channel's fractional delay and the medium's absorption FIR taper with it).
+double kaiser_window(double r, double beta);
+
 }  // namespace ranging

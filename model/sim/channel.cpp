@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "model/base/error.hpp"
+#include "model/dsp/filter_design.hpp"
 
 namespace ranging {
 
@@ -18,32 +19,16 @@ void validate(const ChannelParams& p) {
   require_in_range("noise_rms", p.noise_rms, 0.0, 1e9);
 }
 
-namespace {
-
-// Modified Bessel function I0 by its power series (converges fast for the betas used).
-double bessel_i0(double x) {
-  double sum = 1.0, term = 1.0;
-  const double q = x * x / 4.0;
-  for (int k = 1; k < 200 && term > 1e-17 * sum; ++k) {
-    term *= q / (static_cast<double>(k) * k);
-    sum += term;
-  }
-  return sum;
-}
-
-}  // namespace
-
 // Taps h[i] = sinc(m - mu) * kaiser(m - mu), m = i - (N/2 - 1), so that
 // y[k] = sum_i h[i] z[k - I - m] interpolates z at time k - (I + mu).
 std::vector<double> fractional_delay_taps(double mu) {
   constexpr double beta = 10.0;  // ~-100 dB sidelobes; passband flat far beyond 0.1*fs
   constexpr double half = kDelayTaps / 2.0;
-  const double i0b = bessel_i0(beta);
   std::vector<double> h(kDelayTaps);
   for (int i = 0; i < kDelayTaps; ++i) {
     const double x = static_cast<double>(i - (kDelayTaps / 2 - 1)) - mu;  // in (-N/2, N/2]
     const double r = x / half;
-    const double w = bessel_i0(beta * std::sqrt(std::max(0.0, 1.0 - r * r))) / i0b;
+    const double w = kaiser_window(r, beta);
     const double s = x == 0.0 ? 1.0 : std::sin(std::numbers::pi * x) / (std::numbers::pi * x);
     h[static_cast<std::size_t>(i)] = s * w;
   }

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "model/base/error.hpp"
+#include "model/dsp/filter_design.hpp"
 
 namespace ranging {
 
@@ -56,18 +57,6 @@ double absorption_db_per_m(double f_hz, const AirConditions& a) {
                                     0.1068 * std::exp(-3352.0 / T) / (frN + f2 / frN)));
 }
 
-namespace {
-double bessel_i0(double x) {
-  double sum = 1.0, term = 1.0;
-  const double q = x * x / 4.0;
-  for (int k = 1; k < 300 && term > 1e-17 * sum; ++k) {
-    term *= q / (static_cast<double>(k) * k);
-    sum += term;
-  }
-  return sum;
-}
-}  // namespace
-
 std::vector<double> absorption_fir(const AirConditions& a, double distance_m, double fs) {
   validate(a);
   require_in_range("distance", distance_m, 0.0, 1000.0);
@@ -85,7 +74,6 @@ std::vector<double> absorption_fir(const AirConditions& a, double distance_m, do
   const double sigma = std::sqrt(2.0 * std::max(beta, 0.0)) / (2.0 * std::numbers::pi) * fs;
   const int half = std::clamp(static_cast<int>(std::ceil(8.0 * sigma)) + 128, 16, M / 2 - 1);
   std::vector<double> h(static_cast<std::size_t>(2 * half + 1));
-  const double i0b = bessel_i0(8.0);
   for (int n = -half; n <= half; ++n) {
     double acc = H[0];
     for (int k = 1; k < M / 2; ++k) {
@@ -93,7 +81,7 @@ std::vector<double> absorption_fir(const AirConditions& a, double distance_m, do
     }
     acc += H[M / 2] * std::cos(std::numbers::pi * n);
     const double r = static_cast<double>(n) / (half + 1);
-    const double w = bessel_i0(8.0 * std::sqrt(std::max(0.0, 1.0 - r * r))) / i0b;
+    const double w = kaiser_window(r, 8.0);
     h[static_cast<std::size_t>(n + half)] = acc / M * w;
   }
   return h;
