@@ -284,27 +284,24 @@ StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std
   }
   pk = std::clamp(pk, lo, hi - 1);
   const std::size_t gap = std::max<std::size_t>(guard, 1);
-  std::size_t last = pk, first = pk, quiet = 0;
-  bool ended = false, began = false;
-  for (std::size_t i = pk + 1; i < hi; ++i) {
-    if (std::abs(x[i]) > d.threshold) {
-      last = i;
-      quiet = 0;
-    } else if (++quiet >= gap) {
-      ended = true;
-      break;
+  // From the peak outwards over n samples one way (step +1 or -1): `edge` becomes the outermost
+  // sample above the threshold before `gap` quiet ones in a row; true when that quiet run was met.
+  auto walk = [&](std::ptrdiff_t step, std::size_t n, std::size_t& edge) {
+    std::size_t quiet = 0;
+    for (std::size_t k = 1; k <= n; ++k) {
+      const std::size_t i = pk + static_cast<std::size_t>(step * static_cast<std::ptrdiff_t>(k));
+      if (std::abs(x[i]) > d.threshold) {
+        edge = i;
+        quiet = 0;
+      } else if (++quiet >= gap) {
+        return true;
+      }
     }
-  }
-  quiet = 0;
-  for (std::size_t i = pk; i-- > lo;) {
-    if (std::abs(x[i]) > d.threshold) {
-      first = i;
-      quiet = 0;
-    } else if (++quiet >= gap) {
-      began = true;
-      break;
-    }
-  }
+    return false;
+  };
+  std::size_t last = pk, first = pk;
+  const bool ended = walk(+1, hi - pk - 1, last);
+  const bool began = walk(-1, pk - lo, first);
   if (std::abs(x[pk]) <= d.threshold) first = last = pk;  // the noise floor hides the whole burst
   d.first = first;
   d.last = last;
