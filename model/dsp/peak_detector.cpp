@@ -20,6 +20,27 @@ void best_two(const std::vector<T>& q, int& best, T& second) {
   }
 }
 
+// The candidate's life cycle, the same in both precisions. The output after the candidate's
+// peak is its right neighbour (the parabola's third point).
+template <class Cand, class T>
+void take_right_neighbour(std::optional<Cand>& cand, const std::vector<T>& q) {
+  if (cand && !cand->has_next) {
+    cand->q_next = q[static_cast<std::size_t>(cand->code)];
+    cand->has_next = true;
+  }
+}
+
+// The candidate as an event, and no candidate after it (none: no event). One without a right
+// neighbour (the stream ended first: flush) takes its left one, a symmetric parabola.
+template <class Cand, class Make>
+auto release(std::optional<Cand>& cand, Make&& make_event) -> std::optional<decltype(make_event(*cand))> {
+  if (!cand) return std::nullopt;
+  if (!cand->has_next) cand->q_next = cand->q_prev;
+  auto out = make_event(*cand);
+  cand.reset();
+  return out;
+}
+
 }  // namespace
 
 void validate(const DetectorConfig& cfg) {
@@ -78,10 +99,7 @@ std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank)
   int best;
   double second;
   best_two(q, best, second);
-  if (cand_ && !cand_->has_next) {
-    cand_->q_next = q[cand_->code];
-    cand_->has_next = true;
-  }
+  take_right_neighbour(cand_, q);
   const std::int64_t n = bank.sample_index();
   const double rho2 = bank.rho2(best);
   const bool gate = rho2 >= cfg_.threshold && bank.energy() >= cfg_.min_energy;
@@ -89,21 +107,14 @@ std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank)
     const double margin = rho2 - (bank.energy() > 0 ? second / bank.energy() : 0.0);
     cand_ = Candidate{n, best, prev_[best], q[best], 0.0, rho2, margin, false};
   } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
-    out = make_event(*cand_);
-    cand_.reset();
+    out = release(cand_, [this](const Candidate& c) { return make_event(c); });
   }
   prev_ = q;
   return out;
 }
 
 std::optional<Event> PeakDetectorFloat::flush() {
-  std::optional<Event> out;
-  if (cand_) {
-    if (!cand_->has_next) cand_->q_next = cand_->q_prev;  // no right neighbour: symmetric
-    out = make_event(*cand_);
-    cand_.reset();
-  }
-  return out;
+  return release(cand_, [this](const Candidate& c) { return make_event(c); });
 }
 
 // ---------------------------------------------------------------------------------------
@@ -154,10 +165,7 @@ std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& 
   int best;
   std::uint64_t second;
   best_two(q, best, second);
-  if (cand_ && !cand_->has_next) {
-    cand_->q_next = q[cand_->code];
-    cand_->has_next = true;
-  }
+  take_right_neighbour(cand_, q);
   const std::int64_t n = bank.sample_index();
   const std::uint64_t norm = bank.norm();
   const bool gate = static_cast<uint128_t>(q[best]) >=
@@ -169,21 +177,14 @@ std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& 
   if (gate && better) {
     cand_ = Candidate{n, best, prev_[best], q[best], 0, second, norm, false};
   } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
-    out = make_event(*cand_);
-    cand_.reset();
+    out = release(cand_, [this](const Candidate& c) { return make_event(c); });
   }
   prev_ = q;
   return out;
 }
 
 std::optional<EventFixed> PeakDetectorFixed::flush() {
-  std::optional<EventFixed> out;
-  if (cand_) {
-    if (!cand_->has_next) cand_->q_next = cand_->q_prev;  // no right neighbour: symmetric
-    out = make_event(*cand_);
-    cand_.reset();
-  }
-  return out;
+  return release(cand_, [this](const Candidate& c) { return make_event(c); });
 }
 
 }  // namespace ranging
