@@ -253,18 +253,98 @@ std::vector<TofSample> consistent_chain(std::vector<TofSample> m, double c, doub
   return out;
 }
 
+namespace {
+
+// What the rotor crossings and the Doppler points share: the scene's first family sent every
+// period through the moving channel (model/sim/moving_channel.hpp).
+struct MovingReception {
+  std::vector<double> y;  // the ADC's output, volts
+  long r0 = 0;            // the sample of y[0]
+};
+
+struct MovingBursts {
+  const Scene& s;
+  std::string family;
+  CodeFamily fam;
+  int eta, q;
+  double fs, c;
+  long period, burst_len;
+  long ring;  // 30 amplitude time constants Q/(pi f0) of the TX transducer's ring-down
+  TransducerParams tp;
+  ExcitationParams ex;
+
+  explicit MovingBursts(const Scene& scene)
+      : s(scene),
+        family(s.excitation.families.front()),
+        fam(code_family(family)),
+        eta(fam.eta()),
+        q(s.excitation.q_of(family)),
+        fs(s.fs),
+        c(s.speed()),
+        period(std::lround(s.excitation.schedule.period_s * fs)),
+        burst_len(static_cast<long>(fam.length) * q * std::lround(fs / s.excitation.carrier_hz)),
+        ring(s.transducers.named
+                 ? static_cast<long>(std::ceil(30.0 * s.transducers.q / (kPi * s.transducers.centre_hz) * fs))
+                 : 0),
+        tp{s.transducers.centre_hz, s.transducers.q, false},
+        ex{s.excitation.carrier_hz, q, fs, s.excitation.amplitude()} {}
+
+  std::vector<double> burst(int code) const {
+    return bpsk_excitation(fam.codes[static_cast<std::size_t>(code - 1)], ex);
+  }
+
+  // The emission e (e[0] at sample e0) through the TX transducer, the moving link over the
+  // reception window (from the first sample's earliest arrival to the last one's latest plus
+  // tails; d: the distance the arrival search starts from), the RX transducer, the noise
+  // (noise_v, or snr_db against the on-axis static burst at d, mean square a^2/2; drawn from
+  // `seed`) and the ADC.
+  MovingReception receive(const MovingLink& link, std::vector<double> e, long e0, double d, std::uint64_t seed) const {
+    if (s.transducers.named) {
+      Transducer tx(tp, fs);
+      for (double& v : e) v = tx.execute(v);
+    }
+    const double t_first = static_cast<double>(e0) / fs;
+    const double t_last = static_cast<double>(e0 + static_cast<long>(e.size())) / fs;
+    MovingReception out;
+    out.r0 = static_cast<long>(std::floor(reception_time(link, t_first, t_first + d / c) * fs)) - kDelayTaps;
+    const long r1 = static_cast<long>(std::ceil(reception_time(link, t_last, t_last + d / c) * fs)) + 3 * burst_len + 2000;
+    out.y = render_moving(link, e, e0, out.r0, static_cast<std::size_t>(r1 - out.r0), fs);
+    std::vector<double>& y = out.y;
+    if (s.transducers.named) {
+      Transducer rx(tp, fs);
+      for (double& v : y) v = rx.execute(v);
+    }
+    if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
+      double sigma = s.noise.noise_v.value_or(0.0);
+      if (s.noise.snr_db) {
+        const double a = s.excitation.amplitude() * s.sensitivity * kReferenceDistance / d;
+        sigma = std::sqrt(a * a / 2.0 / std::pow(10.0, *s.noise.snr_db / 10.0));
+      }
+      std::mt19937_64 rng(seed);
+      std::normal_distribution<double> nd(0.0, sigma);
+      for (double& v : y) v += nd(rng);
+    }
+    if (s.noise.adc) {
+      const double qv = s.noise.adc->full_scale_v / std::ldexp(1.0, s.noise.adc->bits - 1);
+      const double top = std::ldexp(1.0, s.noise.adc->bits - 1);
+      for (double& v : y) v = std::clamp(std::round(v / qv), -top, top - 1) * qv;
+    }
+    return out;
+  }
+};
+
+}  // namespace
+
 std::size_t rotor_crossings(const Scene& s) { return static_cast<std::size_t>(s.geometry.rotor.crossings); }
 
 RotorRun run_rotor(SceneSimulator& sim, const std::function<void()>& tick) {
   const Scene& s = sim.scene();
   const RotorParams& p = s.geometry.rotor;
-  const std::string family = s.excitation.families.front();
-  const CodeFamily fam = code_family(family);
-  const int eta = fam.eta();
-  const int q = s.excitation.q_of(family);
-  const double fs = s.fs, c = s.speed();
-  const long period = std::lround(s.excitation.schedule.period_s * fs);
-  const long burst_len = static_cast<long>(fam.length) * q * std::lround(fs / s.excitation.carrier_hz);
+  const MovingBursts mb(s);
+  const std::string& family = mb.family;
+  const int eta = mb.eta;
+  const double fs = mb.fs, c = mb.c;
+  const long period = mb.period, burst_len = mb.burst_len;
   RotorRun run;
   run.family = family;
   run.period_s = static_cast<double>(period) / fs;
@@ -272,11 +352,6 @@ RotorRun run_rotor(SceneSimulator& sim, const std::function<void()>& tick) {
   const double v_u = p.omega_u() * p.r(), v_l = p.omega_l() * p.r();
   run.v_rel = v_u + v_l;
   const double L = s.range_l();
-  const TransducerParams tp{s.transducers.centre_hz, s.transducers.q, false};
-  const long ring = s.transducers.named
-                        ? static_cast<long>(std::ceil(30.0 * s.transducers.q / (kPi * s.transducers.centre_hz) * fs))
-                        : 0;
-  ExcitationParams ex{s.excitation.carrier_hz, q, fs, s.excitation.amplitude()};
 
   for (int i = 0; i < p.crossings; ++i) {
     const double tci = p.crossing_time_s(i), h = p.h_of(i);
@@ -302,43 +377,17 @@ RotorRun run_rotor(SceneSimulator& sim, const std::function<void()>& tick) {
       continue;
     }
     const long e0 = k0 * period - kDelayTaps;
-    const long e1 = k1 * period + burst_len + ring + kDelayTaps;
+    const long e1 = k1 * period + burst_len + mb.ring + kDelayTaps;
     std::vector<double> e(static_cast<std::size_t>(e1 - e0), 0.0);
     for (long k = k0; k <= k1; ++k) {
       const int code = static_cast<int>(k % eta) + 1;
-      const auto b = bpsk_excitation(fam.codes[static_cast<std::size_t>(code - 1)], ex);
+      const auto b = mb.burst(code);
       for (std::size_t n = 0; n < b.size(); ++n) e[static_cast<std::size_t>(k * period - e0) + n] += b[n];
     }
-    if (s.transducers.named) {
-      Transducer tx(tp, fs);
-      for (double& v : e) v = tx.execute(v);
-    }
-    // Reception: from the first burst's earliest arrival to the last burst's latest plus tails.
-    const double t_first = static_cast<double>(e0) / fs;
-    const double t_last = static_cast<double>(e1) / fs;
-    const long r0 = static_cast<long>(std::floor(reception_time(link, t_first, t_first + h / c) * fs)) - kDelayTaps;
-    const long r1 = static_cast<long>(std::ceil(reception_time(link, t_last, t_last + h / c) * fs)) + 3 * burst_len + 2000;
-    auto y = render_moving(link, e, e0, r0, static_cast<std::size_t>(r1 - r0), fs);
-    if (s.transducers.named) {
-      Transducer rx(tp, fs);
-      for (double& v : y) v = rx.execute(v);
-    }
-    // Noise: noise_v, or snr_db against the on-axis static burst at h (mean square a^2/2).
-    if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
-      double sigma = s.noise.noise_v.value_or(0.0);
-      if (s.noise.snr_db) {
-        const double a = s.excitation.amplitude() * s.sensitivity * kReferenceDistance / h;
-        sigma = std::sqrt(a * a / 2.0 / std::pow(10.0, *s.noise.snr_db / 10.0));
-      }
-      std::mt19937_64 rng(s.noise.seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i) + 1);
-      std::normal_distribution<double> nd(0.0, sigma);
-      for (double& v : y) v += nd(rng);
-    }
-    if (s.noise.adc) {
-      const double qv = s.noise.adc->full_scale_v / std::ldexp(1.0, s.noise.adc->bits - 1);
-      const double top = std::ldexp(1.0, s.noise.adc->bits - 1);
-      for (double& v : y) v = std::clamp(std::round(v / qv), -top, top - 1) * qv;
-    }
+    const MovingReception rx =
+        mb.receive(link, std::move(e), e0, h, s.noise.seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i) + 1);
+    const long r0 = rx.r0;
+    const std::vector<double>& y = rx.y;
     std::uint64_t ov = 0;
     const auto dets = sim.receive_stream(family, y, static_cast<double>(r0) / fs, run.period_s, &ov);
     run.overflows += ov;
@@ -422,19 +471,11 @@ RotorRun run_rotor(SceneSimulator& sim, const std::function<void()>& tick) {
 
 DopplerPoint doppler_point(SceneSimulator& sim, double d, double v_los, int repeats) {
   const Scene& s = sim.scene();
-  const std::string family = s.excitation.families.front();
-  const CodeFamily fam = code_family(family);
-  const int eta = fam.eta();
-  const int q = s.excitation.q_of(family);
-  const double fs = s.fs, c = s.speed();
-  const long period = std::lround(s.excitation.schedule.period_s * fs);
-  const long burst_len = static_cast<long>(fam.length) * q * std::lround(fs / s.excitation.carrier_hz);
+  const MovingBursts mb(s);
+  const int eta = mb.eta;
+  const double fs = mb.fs, c = mb.c;
+  const long period = mb.period, burst_len = mb.burst_len;
   const double tb = static_cast<double>(burst_len) / fs, T = static_cast<double>(period) / fs;
-  const TransducerParams tp{s.transducers.centre_hz, s.transducers.q, false};
-  const long ring = s.transducers.named
-                        ? static_cast<long>(std::ceil(30.0 * s.transducers.q / (kPi * s.transducers.centre_hz) * fs))
-                        : 0;
-  ExcitationParams ex{s.excitation.carrier_hz, q, fs, s.excitation.amplitude()};
   DopplerPoint out;
   out.los_speed_mps = v_los;
   double sum_s = 0, sum_c = 0, sum_d = 0, sum_d2 = 0;
@@ -449,37 +490,14 @@ DopplerPoint doppler_point(SceneSimulator& sim, double d, double v_los, int repe
     link.gain = s.sensitivity;
     if (s.medium.air) link.absorption_db_per_m = absorption_db_per_m(s.excitation.carrier_hz, *s.medium.air);
     const long e0 = k * period - kDelayTaps;
-    std::vector<double> e(static_cast<std::size_t>(burst_len + ring + 2 * kDelayTaps), 0.0);
-    const auto b = bpsk_excitation(fam.codes[static_cast<std::size_t>(code - 1)], ex);
+    std::vector<double> e(static_cast<std::size_t>(burst_len + mb.ring + 2 * kDelayTaps), 0.0);
+    const auto b = mb.burst(code);
     for (std::size_t n = 0; n < b.size(); ++n) e[static_cast<std::size_t>(kDelayTaps) + n] = b[n];
-    if (s.transducers.named) {
-      Transducer tx(tp, fs);
-      for (double& v : e) v = tx.execute(v);
-    }
-    const double t_first = static_cast<double>(e0) / fs, t_last = static_cast<double>(e0 + static_cast<long>(e.size())) / fs;
-    const long r0 = static_cast<long>(std::floor(reception_time(link, t_first, t_first + d / c) * fs)) - kDelayTaps;
-    const long r1 = static_cast<long>(std::ceil(reception_time(link, t_last, t_last + d / c) * fs)) + 3 * burst_len + 2000;
-    auto y = render_moving(link, e, e0, r0, static_cast<std::size_t>(r1 - r0), fs);
-    if (s.transducers.named) {
-      Transducer rx(tp, fs);
-      for (double& v : y) v = rx.execute(v);
-    }
-    if (s.noise.named && (s.noise.snr_db || s.noise.noise_v)) {
-      double sigma = s.noise.noise_v.value_or(0.0);
-      if (s.noise.snr_db) {
-        const double a = s.excitation.amplitude() * s.sensitivity * kReferenceDistance / d;
-        sigma = std::sqrt(a * a / 2.0 / std::pow(10.0, *s.noise.snr_db / 10.0));
-      }
-      std::mt19937_64 rng(s.noise.seed * 0x9E3779B97F4A7C15ull + 0x5151u + static_cast<std::uint64_t>(k));
-      std::normal_distribution<double> nd(0.0, sigma);
-      for (double& v : y) v += nd(rng);
-    }
-    if (s.noise.adc) {
-      const double qv = s.noise.adc->full_scale_v / std::ldexp(1.0, s.noise.adc->bits - 1);
-      const double top = std::ldexp(1.0, s.noise.adc->bits - 1);
-      for (double& v : y) v = std::clamp(std::round(v / qv), -top, top - 1) * qv;
-    }
-    const auto dets = sim.receive_stream(family, y, static_cast<double>(r0) / fs, T);
+    const MovingReception rx =
+        mb.receive(link, std::move(e), e0, d, s.noise.seed * 0x9E3779B97F4A7C15ull + 0x5151u + static_cast<std::uint64_t>(k));
+    const long r0 = rx.r0;
+    const std::vector<double>& y = rx.y;
+    const auto dets = sim.receive_stream(mb.family, y, static_cast<double>(r0) / fs, T);
     const double t_start = reception_time(link, tk, tk + d / c);
     const double tcen = tk + tb / 2;
     const double t_centre = reception_time(link, tcen, tcen + d / c);
