@@ -41,6 +41,20 @@ auto release(std::optional<Cand>& cand, Make&& make_event) -> std::optional<decl
   return out;
 }
 
+// One output of the bank: `fresh` becomes the candidate when `take` (the gate is open and the
+// best code's rho^2 beats the candidate's); else the candidate is released as the event once
+// holdoff outputs have followed it.
+template <class Cand, class Make>
+auto next_candidate(std::optional<Cand>& cand, bool take, const Cand& fresh, std::int64_t n, int holdoff,
+                    Make&& make_event) -> std::optional<decltype(make_event(*cand))> {
+  if (take) {
+    cand = fresh;
+    return std::nullopt;
+  }
+  if (cand && cand->has_next && n - cand->n >= holdoff) return release(cand, make_event);
+  return std::nullopt;
+}
+
 }  // namespace
 
 void validate(const DetectorConfig& cfg) {
@@ -95,7 +109,6 @@ Event PeakDetectorFloat::make_event(const Candidate& c) const {
 std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank) {
   const std::vector<double>& q = bank.weighted_power();
   if (prev_.empty()) prev_.assign(q.size(), 0.0);
-  std::optional<Event> out;
   int best;
   double second;
   best_two(q, best, second);
@@ -103,12 +116,10 @@ std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank)
   const std::int64_t n = bank.sample_index();
   const double rho2 = bank.rho2(best);
   const bool gate = rho2 >= cfg_.threshold && bank.energy() >= cfg_.min_energy;
-  if (gate && (!cand_ || rho2 > cand_->score)) {
-    const double margin = rho2 - (bank.energy() > 0 ? second / bank.energy() : 0.0);
-    cand_ = Candidate{n, best, prev_[best], q[best], 0.0, rho2, margin, false};
-  } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
-    out = release(cand_, [this](const Candidate& c) { return make_event(c); });
-  }
+  const double margin = rho2 - (bank.energy() > 0 ? second / bank.energy() : 0.0);
+  auto out = next_candidate(cand_, gate && (!cand_ || rho2 > cand_->score),
+                            Candidate{n, best, prev_[best], q[best], 0.0, rho2, margin, false}, n, holdoff_,
+                            [this](const Candidate& c) { return make_event(c); });
   prev_ = q;
   return out;
 }
@@ -161,7 +172,6 @@ EventFixed PeakDetectorFixed::make_event(const Candidate& c) const {
 std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& bank) {
   const std::vector<std::uint64_t>& q = bank.weighted_power();
   if (prev_.empty()) prev_.assign(q.size(), 0);
-  std::optional<EventFixed> out;
   int best;
   std::uint64_t second;
   best_two(q, best, second);
@@ -174,11 +184,8 @@ std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& 
   // rho^2 of the best code beats the candidate's: Q / norm > Q_c / norm_c, cross-multiplied.
   const bool better = !cand_ || static_cast<uint128_t>(q[best]) * std::max<std::uint64_t>(cand_->norm, 1) >
                                     static_cast<uint128_t>(cand_->q) * std::max<std::uint64_t>(norm, 1);
-  if (gate && better) {
-    cand_ = Candidate{n, best, prev_[best], q[best], 0, second, norm, false};
-  } else if (cand_ && cand_->has_next && n - cand_->n >= holdoff_) {
-    out = release(cand_, [this](const Candidate& c) { return make_event(c); });
-  }
+  auto out = next_candidate(cand_, gate && better, Candidate{n, best, prev_[best], q[best], 0, second, norm, false}, n,
+                            holdoff_, [this](const Candidate& c) { return make_event(c); });
   prev_ = q;
   return out;
 }
