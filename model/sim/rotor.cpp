@@ -186,42 +186,40 @@ double estimate_h_motion(const RotorParams& p, const std::vector<TofSample>& m, 
                  r * std::sin(a) - r * std::sin(wu * te) - u[1] * s.tof_s, -hh - u[2] * s.tof_s};
     return norm(d) - c * s.tof_s;
   };
-  for (int it = 0; it < 50; ++it) {
-    // Normal equations of the 2-parameter Gauss-Newton step, numeric Jacobian.
+  // Normal equations of the 2-parameter Gauss-Newton step at (h, tc), numeric Jacobian.
+  struct Normal {
     double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
+    double det() const { return a11 * a22 - a12 * a12; }
+  };
+  auto normal = [&](double hh, double tt) {
+    Normal ne;
     const double eh = 1e-7, et = 1e-9;
     for (const auto& s : m) {
-      const double f = res(h, tc, s);
-      const double jh = (res(h + eh, tc, s) - res(h - eh, tc, s)) / (2 * eh);
-      const double jt = (res(h, tc + et, s) - res(h, tc - et, s)) / (2 * et);
-      a11 += jh * jh;
-      a12 += jh * jt;
-      a22 += jt * jt;
-      b1 += jh * f;
-      b2 += jt * f;
+      const double f = res(hh, tt, s);
+      const double jh = (res(hh + eh, tt, s) - res(hh - eh, tt, s)) / (2 * eh);
+      const double jt = (res(hh, tt + et, s) - res(hh, tt - et, s)) / (2 * et);
+      ne.a11 += jh * jh;
+      ne.a12 += jh * jt;
+      ne.a22 += jt * jt;
+      ne.b1 += jh * f;
+      ne.b2 += jt * f;
     }
-    const double det = a11 * a22 - a12 * a12;
+    return ne;
+  };
+  for (int it = 0; it < 50; ++it) {
+    const Normal ne = normal(h, tc);
+    const double det = ne.det();
     if (!(std::abs(det) > 0)) return nan;
-    const double dh = (a22 * b1 - a12 * b2) / det, dt = (a11 * b2 - a12 * b1) / det;
+    const double dh = (ne.a22 * ne.b1 - ne.a12 * ne.b2) / det, dt = (ne.a11 * ne.b2 - ne.a12 * ne.b1) / det;
     h -= dh;
     tc -= dt;
     h = std::abs(h);
     if (std::abs(dh) < 1e-10 && std::abs(dt) < 1e-13) break;
   }
   // Converged when a further step moves h by less than a nanometre.
-  double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
-  for (const auto& s : m) {
-    const double f = res(h, tc, s);
-    const double jh = (res(h + 1e-7, tc, s) - res(h - 1e-7, tc, s)) / 2e-7;
-    const double jt = (res(h, tc + 1e-9, s) - res(h, tc - 1e-9, s)) / 2e-9;
-    a11 += jh * jh;
-    a12 += jh * jt;
-    a22 += jt * jt;
-    b1 += jh * f;
-    b2 += jt * f;
-  }
-  const double det = a11 * a22 - a12 * a12;
-  if (!(std::abs(det) > 0) || std::abs((a22 * b1 - a12 * b2) / det) > 1e-9 || !std::isfinite(h)) return nan;
+  const Normal ne = normal(h, tc);
+  const double det = ne.det();
+  if (!(std::abs(det) > 0) || std::abs((ne.a22 * ne.b1 - ne.a12 * ne.b2) / det) > 1e-9 || !std::isfinite(h)) return nan;
   if (t_c_out) *t_c_out = tc;
   return h;
 }
