@@ -100,7 +100,19 @@ std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::stri
   const auto code_w = det.value("CODE_W"), frac_w = det.value("FRAC_W"), score_w = det.value("SCORE_W");
   const auto arrival_w = time_w + frac_w + 1;
   const auto event_w = code_w + arrival_w + 2 * score_w;
+  // The bank's stream to the detector, tapped as the dbg_<name> ports: one list for the ports,
+  // the bank_<name> wires and the assigns.
+  struct Tap {
+    const char* name;
+    std::int64_t width;  // 0: a scalar wire
+  };
+  const Tap bank_stream[] = {{"weighted", weighted_w}, {"code", code_w}, {"last", 0}, {"energy", energy_w}, {"index", time_w}};
   std::ostringstream os;
+  auto declare = [&](const char* kind, const Tap& t, const char* prefix, const char* end) {
+    os << "  " << kind << " ";
+    if (t.width > 0) os << "[" << t.width - 1 << ":0] ";
+    os << prefix << t.name << end << "\n";
+  };
   os << banner("//", origin)
      << "//\n"
         "// receiver_top: the coded-ultrasound receiver (docs/architecture.md):\n"
@@ -126,26 +138,18 @@ std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::stri
         "  output wire dbg_filter_valid,\n"
         "  output wire signed [" << data_w - 1 << ":0] dbg_filter_data,\n"
         "  output wire [" << sections * data_w - 1 << ":0] dbg_filter_sections,\n"
-        "  output wire dbg_bank_valid,\n"
-        "  output wire [" << weighted_w - 1 << ":0] dbg_weighted,\n"
-        "  output wire [" << code_w - 1 << ":0] dbg_code,\n"
-        "  output wire dbg_last,\n"
-        "  output wire [" << energy_w - 1 << ":0] dbg_energy,\n"
-        "  output wire [" << time_w - 1 << ":0] dbg_index,\n"
-        "  output wire signed [" << chip_w - 1 << ":0] dbg_chip_re,\n"
+        "  output wire dbg_bank_valid,\n";
+  for (const auto& t : bank_stream) declare("output wire", t, "dbg_", ",");
+  os << "  output wire signed [" << chip_w - 1 << ":0] dbg_chip_re,\n"
         "  output wire signed [" << chip_w - 1 << ":0] dbg_chip_im,\n"
         "  output wire signed [" << corr_w - 1 << ":0] dbg_corr_re,\n"
         "  output wire signed [" << corr_w - 1 << ":0] dbg_corr_im\n"
         ");\n\n"
         "  wire signed [" << data_w - 1 << ":0] filter_data;\n"
         "  wire filter_valid, filter_ready;\n"
-        "  wire bank_valid, bank_ready;\n"
-        "  wire [" << weighted_w - 1 << ":0] bank_weighted;\n"
-        "  wire [" << code_w - 1 << ":0] bank_code;\n"
-        "  wire bank_last;\n"
-        "  wire [" << energy_w - 1 << ":0] bank_energy;\n"
-        "  wire [" << time_w - 1 << ":0] bank_index;\n"
-        "  wire [" << code_w - 1 << ":0] event_code;\n"
+        "  wire bank_valid, bank_ready;\n";
+  for (const auto& t : bank_stream) declare("wire", t, "bank_", ";");
+  os << "  wire [" << code_w - 1 << ":0] event_code;\n"
         "  wire signed [" << arrival_w - 1 << ":0] event_arrival;\n"
         "  wire [" << score_w - 1 << ":0] event_score, event_margin;\n\n"
         "  bandpass_sos #(\n" << instance_params(sos) << "  ) u_filter (\n"
@@ -175,12 +179,9 @@ std::string verilog_top(const std::vector<HwModuleParams>& mods, const std::stri
         "  assign m_axis_tdata = {event_margin, event_score, event_arrival, event_code};\n"
         "  assign dbg_filter_valid = filter_valid & filter_ready;\n"
         "  assign dbg_filter_data = filter_data;\n"
-        "  assign dbg_bank_valid = bank_valid & bank_ready;\n"
-        "  assign dbg_weighted = bank_weighted;\n"
-        "  assign dbg_code = bank_code;\n"
-        "  assign dbg_last = bank_last;\n"
-        "  assign dbg_energy = bank_energy;\n"
-        "  assign dbg_index = bank_index;\n\n"
+        "  assign dbg_bank_valid = bank_valid & bank_ready;\n";
+  for (const auto& t : bank_stream) os << "  assign dbg_" << t.name << " = bank_" << t.name << ";\n";
+  os << "\n"
         "endmodule\n\n`default_nettype wire\n";
   return os.str();
 }
