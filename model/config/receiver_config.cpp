@@ -5,6 +5,7 @@
 
 #include "model/base/error.hpp"
 #include "model/base/input_file.hpp"
+#include "model/base/names.hpp"
 #include "model/config/yaml_reader.hpp"
 
 namespace ranging {
@@ -14,24 +15,15 @@ namespace {
 using yaml::Reader;
 using yaml::section;
 
-Rounding parse_rounding(Reader& r, const std::string& k, const std::string& s) {
-  if (s == "truncate") return Rounding::Truncate;
-  if (s == "round-half-up") return Rounding::RoundHalfUp;
-  if (s == "convergent") return Rounding::Convergent;
-  r.error(k, "'" + s + "' is not valid; valid: truncate, round-half-up, convergent");
-}
-std::string rounding_name(Rounding r) {
-  switch (r) {
-    case Rounding::Truncate: return "truncate";
-    case Rounding::RoundHalfUp: return "round-half-up";
-    case Rounding::Convergent: return "convergent";
-  }
-  return "?";
-}
-Overflow parse_overflow(Reader& r, const std::string& k, const std::string& s) {
-  if (s == "wrap") return Overflow::Wrap;
-  if (s == "saturate") return Overflow::Saturate;
-  r.error(k, "'" + s + "' is not valid; valid: wrap, saturate");
+constexpr NameTable<Rounding, 3> kRoundings{{
+    {Rounding::Truncate, "truncate"}, {Rounding::RoundHalfUp, "round-half-up"}, {Rounding::Convergent, "convergent"}}};
+constexpr NameTable<Overflow, 2> kOverflows{{{Overflow::Wrap, "wrap"}, {Overflow::Saturate, "saturate"}}};
+
+// The value of a name in the table; else an error naming the key and the valid names.
+template <class E, std::size_t N>
+E parse_name(Reader& r, const std::string& k, const std::string& s, const NameTable<E, N>& table) {
+  if (const auto v = value_of(table, s)) return *v;
+  r.error(k, "'" + s + "' is not valid; valid: " + names_list(table));
 }
 
 }  // namespace
@@ -77,11 +69,11 @@ ReceiverConfig parse_document(YAML::Node root, const std::string& origin, bool a
     r.get("data_bits", b.data_bits);
     r.get("data_frac", b.data_frac);
     r.get("acc_bits", b.acc_bits);
-    std::string rnd = rounding_name(b.rounding), ovf = b.overflow == Overflow::Wrap ? "wrap" : "saturate";
+    std::string rnd = name_of(kRoundings, b.rounding), ovf = name_of(kOverflows, b.overflow);
     r.get("rounding", rnd);
     r.get("overflow", ovf);
-    b.rounding = parse_rounding(r, "rounding", rnd);
-    b.overflow = parse_overflow(r, "overflow", ovf);
+    b.rounding = parse_name(r, "rounding", rnd, kRoundings);
+    b.overflow = parse_name(r, "overflow", ovf, kOverflows);
   });
   section(top, "correlator", [&](Reader& r) {
     r.get("reference", cfg.reference);
@@ -176,8 +168,8 @@ std::string receiver_config_yaml(const ReceiverConfig& c) {
   const auto& b = c.bandpass;
   os << "bandpass_fixed:\n  input_bits: " << b.input_bits << "\n  coef_bits: " << b.coef_bits
      << "\n  coef_frac: " << b.coef_frac << "\n  data_bits: " << b.data_bits << "\n  data_frac: "
-     << b.data_frac << "\n  acc_bits: " << b.acc_bits << "\n  rounding: " << rounding_name(b.rounding)
-     << "\n  overflow: " << (b.overflow == Overflow::Wrap ? "wrap" : "saturate") << "\n";
+     << b.data_frac << "\n  acc_bits: " << b.acc_bits << "\n  rounding: " << name_of(kRoundings, b.rounding)
+     << "\n  overflow: " << name_of(kOverflows, b.overflow) << "\n";
   os << "correlator:\n  reference: " << c.reference << "\n  transducer_centre_hz: "
      << c.reference_transducer.centre_hz << "\n  transducer_q: " << c.reference_transducer.q
      << "\n  decimation: " << c.decimation << "\n  template_floor: " << c.template_floor << "\n";

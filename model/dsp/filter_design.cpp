@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "model/base/error.hpp"
+#include "model/base/names.hpp"
 
 namespace ranging {
 namespace {
@@ -499,21 +500,17 @@ SosFilter design_bandpass(const BandpassSpec& spec, FilterType type) {
   return design_bandpass(spec, type, order);
 }
 
+namespace {
+constexpr NameTable<FilterType, 3> kFilterTypes{
+    {{FilterType::Butterworth, "butter"}, {FilterType::Chebyshev1, "cheby1"}, {FilterType::Elliptic, "ellip"}}};
+}  // namespace
+
 FilterType parse_filter_type(std::string_view name) {
-  if (name == "butter") return FilterType::Butterworth;
-  if (name == "cheby1") return FilterType::Chebyshev1;
-  if (name == "ellip") return FilterType::Elliptic;
-  throw InputError("filter type: '" + std::string(name) + "' is not one of butter, cheby1, ellip");
+  if (const auto t = value_of(kFilterTypes, name)) return *t;
+  throw InputError("filter type: '" + std::string(name) + "' is not one of " + names_list(kFilterTypes));
 }
 
-std::string filter_type_name(FilterType type) {
-  switch (type) {
-    case FilterType::Butterworth: return "butter";
-    case FilterType::Chebyshev1: return "cheby1";
-    case FilterType::Elliptic: return "ellip";
-  }
-  return "?";
-}
+std::string filter_type_name(FilterType type) { return name_of(kFilterTypes, type); }
 
 namespace {
 // Modified Bessel function I0 by its power series (converges fast for the betas used).
