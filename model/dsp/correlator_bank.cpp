@@ -55,9 +55,21 @@ std::vector<std::vector<int>> code_signs(const std::vector<std::vector<std::uint
   return signs;
 }
 
+// F outputs the combiner reaches back: L - 1 chips of Nc / D outputs, and the current one.
+std::size_t combiner_history(std::size_t chips, int chip_samples, int decimation) {
+  return (chips - 1) * static_cast<std::size_t>(chip_samples / decimation) + 1;
+}
 std::size_t combiner_history(const CorrelatorReference& r) {
-  const std::size_t chips = r.codes.front().size();
-  return (chips - 1) * static_cast<std::size_t>(r.chip_samples / r.decimation) + 1;
+  return combiner_history(r.codes.front().size(), r.chip_samples, r.decimation);
+}
+
+// A mirrored ring of n complex values, zeroed: re and im are 2 n long, so every read of the
+// last n is one contiguous window. Returns the index of its newest slot.
+template <class T>
+std::size_t reset_ring(std::vector<T>& re, std::vector<T>& im, std::size_t n) {
+  re.assign(2 * n, T{});
+  im.assign(2 * n, T{});
+  return n - 1;
 }
 
 }  // namespace
@@ -212,14 +224,10 @@ void CorrelatorBankFloat::reset() {
     lo_sin_.push_back(std::sin(w));
   }
   bd_n_ = ref_.chip_taps.size();
-  bd_re_.assign(2 * bd_n_, 0.0);
-  bd_im_.assign(2 * bd_n_, 0.0);
+  bd_idx_ = reset_ring(bd_re_, bd_im_, bd_n_);
   f_n_ = combiner_history(ref_);
-  f_re_.assign(2 * f_n_, 0.0);
-  f_im_.assign(2 * f_n_, 0.0);
+  f_idx_ = reset_ring(f_re_, f_im_, f_n_);
   y2_.assign(static_cast<std::size_t>(ref_.window), 0.0);
-  bd_idx_ = bd_n_ - 1;
-  f_idx_ = f_n_ - 1;
   y_idx_ = y2_.size() - 1;
   q_.assign(ref_.codes.size(), 0.0);
 }
@@ -298,14 +306,10 @@ void CorrelatorBankFixed::reset() {
   b_re_.assign(static_cast<std::size_t>(l.period), 0);
   b_im_.assign(b_re_.size(), 0);
   bd_n_ = static_cast<std::size_t>(l.taps);
-  bd_re_.assign(2 * bd_n_, 0);
-  bd_im_.assign(2 * bd_n_, 0);
-  f_n_ = static_cast<std::size_t>(l.chips - 1) * static_cast<std::size_t>(l.chip_samples / l.decimation) + 1;
-  f_re_.assign(2 * f_n_, 0);
-  f_im_.assign(2 * f_n_, 0);
+  bd_idx_ = reset_ring(bd_re_, bd_im_, bd_n_);
+  f_n_ = combiner_history(static_cast<std::size_t>(l.chips), l.chip_samples, l.decimation);
+  f_idx_ = reset_ring(f_re_, f_im_, f_n_);
   y2_.assign(static_cast<std::size_t>(l.window), 0);
-  bd_idx_ = bd_n_ - 1;
-  f_idx_ = f_n_ - 1;
   y_idx_ = y2_.size() - 1;
   energy_ = 0;
   corr_re_.assign(l.codes, 0);

@@ -90,11 +90,6 @@ PeakDetectorFloat::PeakDetectorFloat(const DetectorConfig& cfg, const Correlator
   validate(cfg);
 }
 
-void PeakDetectorFloat::reset() {
-  prev_.clear();
-  cand_.reset();
-}
-
 Event PeakDetectorFloat::make_event(const Candidate& c) const {
   Event e;
   e.code = c.code + 1;
@@ -152,11 +147,6 @@ PeakDetectorFixed::PeakDetectorFixed(const DetectorConfig& cfg, const Correlator
   thr_q_ = l.threshold_q;
   min_norm_ = l.min_norm_q;
   holdoff_ = l.holdoff;
-}
-
-void PeakDetectorFixed::reset() {
-  prev_.clear();
-  cand_.reset();
 }
 
 EventFixed PeakDetectorFixed::make_event(const Candidate& c) const {

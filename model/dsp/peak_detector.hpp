@@ -63,7 +63,10 @@ struct EventFixed {
 class PeakDetectorFloat {
  public:
   PeakDetectorFloat(const DetectorConfig& cfg, const CorrelatorReference& ref);
-  void reset();
+  void reset() {
+    prev_.clear();
+    cand_.reset();
+  }
   // Call after every bank.execute() that returned true.
   std::optional<Event> execute(const CorrelatorBankFloat& bank);
   std::optional<Event> flush();  // end of stream: emit a pending candidate
@@ -99,7 +102,10 @@ class PeakDetectorFixed {
  public:
   PeakDetectorFixed(const DetectorConfig& cfg, const CorrelatorFixedLayout& layout,
                     const CorrelatorFixedConfig& corr);
-  void reset();
+  void reset() {
+    prev_.clear();
+    cand_.reset();
+  }
   std::optional<EventFixed> execute(const CorrelatorBankFixed& bank);
   std::optional<EventFixed> flush();
 
