@@ -149,6 +149,59 @@ std::vector<SceneStage> scene_stages(const Scene& s) {
 
 // ---------------------------------------------------------------------------------------
 
+namespace {
+
+// The stages of a clean burst (SceneSimulator::Link::clean), in the order they apply.
+
+// The TX and RX resonators, with 30 amplitude time constants Q/(pi f0) of ring-down appended.
+void through_transducers(const Scene& s, std::vector<double>& z) {
+  const double tau = s.transducers.q / (std::numbers::pi * s.transducers.centre_hz) * s.fs;
+  z.resize(z.size() + static_cast<std::size_t>(std::ceil(30.0 * tau)) + 16, 0.0);
+  const TransducerParams tp{s.transducers.centre_hz, s.transducers.q, false};
+  Transducer tx(tp, s.fs), rx(tp, s.fs);
+  for (double& v : z) v = rx.execute(tx.execute(v));
+}
+
+// The zero-phase absorption FIR h: z grows by h's length, and its start z0 moves back by half.
+void absorb(const std::vector<double>& h, std::vector<double>& z, long& z0) {
+  const long half = static_cast<long>(h.size() / 2);
+  std::vector<double> w(z.size() + h.size() - 1, 0.0);
+  for (std::size_t n = 0; n < z.size(); ++n) {
+    if (z[n] == 0.0) continue;
+    for (std::size_t i = 0; i < h.size(); ++i) w[n + i] += z[n] * h[i];
+  }
+  z = std::move(w);
+  z0 -= half;
+}
+
+// Spherical spreading 0.1 m / d, the sensitivity and (off axis) both pistons' directivity.
+double path_gain(const Scene& s, double d) {
+  double g = s.sensitivity * kReferenceDistance / d;
+  if (s.geometry.angle_deg) g *= std::pow(piston_directivity(s.transducers.beam_angle_deg, *s.geometry.angle_deg), 2);
+  return g;
+}
+
+// z delayed by `shift` samples (propagate()'s fractional-delay interpolator) and scaled by g.
+Sparse delay_and_gain(const std::vector<double>& z, double shift, double g) {
+  const double whole = std::floor(shift);
+  const auto taps = fractional_delay_taps(shift - whole);
+  constexpr long m_lo = -(kDelayTaps / 2 - 1);
+  const long I = static_cast<long>(whole);
+  Sparse out;
+  out.start = I + m_lo;
+  out.y.assign(z.size() + kDelayTaps - 1, 0.0);
+  for (std::size_t j = 0; j < z.size(); ++j) {
+    if (z[j] == 0.0) continue;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(kDelayTaps); ++i) {
+      // y[k] = sum_i taps[i] z[k - I - (m_lo + i)]: for fixed j, k = I + m_lo + i + j.
+      out.y[j + i] += g * taps[i] * z[j];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 struct SceneSimulator::Link {
   const Scene* scene = nullptr;
   const FixedStreamObserver* observer = nullptr;
@@ -170,7 +223,8 @@ struct SceneSimulator::Link {
     return scene->noise.adc ? scene->noise.adc->full_scale_v : scene->receiver.full_scale_v;
   }
 
-  // Noise-free received burst of code j sent at t = 0 over distance d (volts).
+  // Noise-free received burst of code j sent at t = 0 over distance d (volts): the scene's
+  // deterministic stages in order (scene_stages()).
   const Sparse& clean(int code, double d) {
     const auto key = std::make_pair(code, std::llround(d * 1e9));
     if (auto it = cache.find(key); it != cache.end()) return it->second;
@@ -178,46 +232,13 @@ struct SceneSimulator::Link {
     ExcitationParams ex{s.excitation.carrier_hz, design.config.cycles_per_chip, s.fs, s.excitation.amplitude()};
     std::vector<double> z = bpsk_excitation(design.family.codes[static_cast<std::size_t>(code - 1)], ex);
     long z0 = 0;  // sample index of z[0]
-    if (s.transducers.named) {
-      // 30 amplitude time constants Q/(pi f0) of ring-down.
-      const double tau = s.transducers.q / (std::numbers::pi * s.transducers.centre_hz) * s.fs;
-      z.resize(z.size() + static_cast<std::size_t>(std::ceil(30.0 * tau)) + 16, 0.0);
-      const TransducerParams tp{s.transducers.centre_hz, s.transducers.q, false};
-      Transducer tx(tp, s.fs), rx(tp, s.fs);
-      for (double& v : z) v = rx.execute(tx.execute(v));
-    }
+    if (s.transducers.named) through_transducers(s, z);
     if (s.medium.air) {
       auto& h = fir_cache[key.second];
       if (h.empty()) h = absorption_fir(*s.medium.air, d, s.fs);
-      const long half = static_cast<long>(h.size() / 2);
-      std::vector<double> w(z.size() + h.size() - 1, 0.0);
-      for (std::size_t n = 0; n < z.size(); ++n) {
-        if (z[n] == 0.0) continue;
-        for (std::size_t i = 0; i < h.size(); ++i) w[n + i] += z[n] * h[i];
-      }
-      z = std::move(w);
-      z0 -= half;
+      absorb(h, z, z0);
     }
-    double g = s.sensitivity * kReferenceDistance / d;
-    if (s.geometry.angle_deg) g *= std::pow(piston_directivity(s.transducers.beam_angle_deg, *s.geometry.angle_deg), 2);
-    // Fractional delay of the whole burst (propagate()'s interpolator).
-    const double shift = d / c() * s.fs + static_cast<double>(z0);
-    const double whole = std::floor(shift);
-    const auto taps = fractional_delay_taps(shift - whole);
-    constexpr long m_lo = -(kDelayTaps / 2 - 1);
-    const long I = static_cast<long>(whole);
-    Sparse out;
-    out.start = I + m_lo;
-    out.y.assign(z.size() + kDelayTaps - 1, 0.0);
-    for (std::size_t j = 0; j < z.size(); ++j) {
-      if (z[j] == 0.0) continue;
-      for (std::size_t i = 0; i < static_cast<std::size_t>(kDelayTaps); ++i) {
-        // output k = I + m + j with m = m_lo + i  ->  out index j + (kDelayTaps - 1 - i)?
-        // y[k] = sum_i taps[i] z[k - I - (m_lo + i)]: for fixed j, k = I + m_lo + i + j.
-        out.y[j + i] += g * taps[i] * z[j];
-      }
-    }
-    return cache.emplace(key, std::move(out)).first->second;
+    return cache.emplace(key, delay_and_gain(z, d / c() * s.fs + static_cast<double>(z0), path_gain(s, d))).first->second;
   }
 
   static void add_into(std::vector<double>& x, const Sparse& b, long shift) {
@@ -234,41 +255,51 @@ struct SceneSimulator::Link {
   // clamped (fixed precision): appends the indices of the samples the input clamp to +-scale cut.
   std::vector<Event> receive(const std::vector<double>& volts, double scale, std::vector<double>& filtered,
                              std::uint64_t* ovf = nullptr, std::vector<std::size_t>* clamped = nullptr) {
-    std::vector<Event> ev;
     filtered.resize(volts.size());
+    if (!fixed()) return receive_float(volts, scale, filtered);
+    return receive_fixed(volts, scale, filtered, *(ovf ? ovf : &overflows), clamped);
+  }
+
+  std::vector<Event> receive_float(const std::vector<double>& volts, double scale, std::vector<double>& filtered) const {
+    std::vector<Event> ev;
     const double inv = 1.0 / scale;
-    if (!fixed()) {
-      ReceiverFloat rf(design);
-      for (std::size_t n = 0; n < volts.size(); ++n) {
-        if (auto e = rf.execute(volts[n] * inv)) ev.push_back(*e);
-        filtered[n] = rf.filtered() * scale;
-      }
-      if (auto e = rf.flush()) ev.push_back(*e);
-    } else {
-      ReceiverFixed rx(design);
-      BandpassFloat bp(design.filter);
-      const bool observed = observer && *observer;
-      OverflowCounter adc;
-      // The same quantization as ReceiverFixed::execute(double), a chunk at a time (the whole
-      // stream's codes are kept only for the observer).
-      constexpr std::size_t kChunk = 4096;
-      std::vector<std::int64_t> raw(observed ? volts.size() : std::min(kChunk, volts.size()));
-      std::vector<EventFixed> raw_events;
-      for (std::size_t n0 = 0; n0 < volts.size(); n0 += kChunk) {
-        const std::size_t n1 = std::min(volts.size(), n0 + kChunk);
-        std::int64_t* q = raw.data() + (observed ? n0 : 0);
-        for (std::size_t n = n0; n < n1; ++n) {
-          if (clamped && std::abs(volts[n] * inv) > 1.0) clamped->push_back(n);
-          q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
-        }
-        rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
-        for (std::size_t n = n0; n < n1; ++n) filtered[n] = bp.execute(volts[n]);
-      }
-      for (const auto& e : raw_events) ev.push_back(rx.to_float(e));
-      if (auto e = rx.flush()) ev.push_back(*e);
-      if (observed) (*observer)(design, raw, raw_events);
-      *(ovf ? ovf : &overflows) += rx.overflow_events().total() + adc.total();  // adc: input saturations
+    ReceiverFloat rf(design);
+    for (std::size_t n = 0; n < volts.size(); ++n) {
+      if (auto e = rf.execute(volts[n] * inv)) ev.push_back(*e);
+      filtered[n] = rf.filtered() * scale;
     }
+    if (auto e = rf.flush()) ev.push_back(*e);
+    return ev;
+  }
+
+  // The fixed receiver's saturations and wraps, the ADC's input saturations among them, are added to ovf.
+  std::vector<Event> receive_fixed(const std::vector<double>& volts, double scale, std::vector<double>& filtered,
+                                   std::uint64_t& ovf, std::vector<std::size_t>* clamped) const {
+    std::vector<Event> ev;
+    const double inv = 1.0 / scale;
+    ReceiverFixed rx(design);
+    BandpassFloat bp(design.filter);
+    const bool observed = observer && *observer;
+    OverflowCounter adc;
+    // The same quantization as ReceiverFixed::execute(double), a chunk at a time (the whole
+    // stream's codes are kept only for the observer).
+    constexpr std::size_t kChunk = 4096;
+    std::vector<std::int64_t> raw(observed ? volts.size() : std::min(kChunk, volts.size()));
+    std::vector<EventFixed> raw_events;
+    for (std::size_t n0 = 0; n0 < volts.size(); n0 += kChunk) {
+      const std::size_t n1 = std::min(volts.size(), n0 + kChunk);
+      std::int64_t* q = raw.data() + (observed ? n0 : 0);
+      for (std::size_t n = n0; n < n1; ++n) {
+        if (clamped && std::abs(volts[n] * inv) > 1.0) clamped->push_back(n);
+        q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
+      }
+      rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
+      for (std::size_t n = n0; n < n1; ++n) filtered[n] = bp.execute(volts[n]);
+    }
+    for (const auto& e : raw_events) ev.push_back(rx.to_float(e));
+    if (auto e = rx.flush()) ev.push_back(*e);
+    if (observed) (*observer)(design, raw, raw_events);
+    ovf += rx.overflow_events().total() + adc.total();
     return ev;
   }
 
