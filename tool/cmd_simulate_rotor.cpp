@@ -63,16 +63,9 @@ int simulate_rotor(SceneSimulator& sim, const std::string& out, bool json, bool 
   });
   if (bar) std::fprintf(stderr, "\n");
 
-  nlohmann::json j;
-  j["scene"] = s.name;
-  j["geometry"] = "rotor";
-  j["family"] = run.family;
-  j["period_s"] = run.period_s;
-  j["burst_s"] = run.burst_s;
-  j["relative_tip_speed_mps"] = run.v_rel;
-  j["misdecodes"] = run.misdecodes;
-  j["false_alarms"] = run.false_alarms;
-  j["overflows"] = run.overflows;
+  nlohmann::json j = {{"scene", s.name}, {"geometry", "rotor"}, {"family", run.family},
+                      {"period_s", run.period_s}, {"burst_s", run.burst_s}, {"relative_tip_speed_mps", run.v_rel},
+                      {"misdecodes", run.misdecodes}, {"false_alarms", run.false_alarms}, {"overflows", run.overflows}};
   Stats motion, paper;
   std::size_t fail_motion = 0, fail_paper = 0, decoded = 0;
   for (const auto& b : run.bursts) decoded += b.decoded;

@@ -19,15 +19,14 @@ void warn_if_out_of_spec(const std::string& cmd, const ReceiverConfig& cfg) {
 }
 
 nlohmann::ordered_json guard_json(const DesignGuard& g, int filter_order) {
-  nlohmann::ordered_json j;
-  j["ok"] = g.ok();
-  j["stable"] = g.stable;
-  j["within_spec"] = g.within_spec;
-  j["float_within_spec"] = g.float_within_spec;
-  j["tolerance_db"] = g.tolerance_db;
-  j["coef_bits"] = g.coef_bits;
-  j["coef_frac"] = g.coef_frac;
-  j["message"] = guard_message(g, filter_order);
+  nlohmann::ordered_json j = {{"ok", g.ok()},
+                              {"stable", g.stable},
+                              {"within_spec", g.within_spec},
+                              {"float_within_spec", g.float_within_spec},
+                              {"tolerance_db", g.tolerance_db},
+                              {"coef_bits", g.coef_bits},
+                              {"coef_frac", g.coef_frac},
+                              {"message", guard_message(g, filter_order)}};
   nlohmann::ordered_json sec = nlohmann::ordered_json::array();
   for (std::size_t k = 0; k < g.quantized_poles.size(); ++k) {
     const SectionPoles& p = g.quantized_poles[k];
