@@ -40,10 +40,10 @@
 /* verilator lint_off WIDTH */
 
 module adc_interface #(
-  parameter integer CLK_DIV = 9,
-  parameter integer ADC_W = 12,
-  parameter integer ADC_OFFSET_BINARY = 1,
-  parameter integer COUNT_W = 16
+  parameter integer CLK_DIV = 9,             // system clocks per ADC period, >= 2
+  parameter integer ADC_W = 12,              // ADC word width
+  parameter integer ADC_OFFSET_BINARY = 1,   // 1: straight binary from the ADC (MSB inverted); 0: two's complement
+  parameter integer COUNT_W = 16             // width of the saturating overrun counter
 ) (
   input  wire clk, rst,
   output reg  adc_clk,

@@ -124,9 +124,6 @@ module bandpass_sos #(
   localparam integer SW = (ACC_W > PW) ? ACC_W : PW;         // accumulate width (mod 2^ACC_W)
   localparam integer SHIFT = COEF_FRAC;                      // fraction bits dropped by the quantizer
   localparam integer IN_SHIFT = DATA_FRAC - (IN_W - 1);      // input alignment (>= 0, model-validated)
-  // Rounding headroom: acc + 2^(SHIFT-1) can never overflow RW bits.
-  localparam integer RW = ((ACC_W > SHIFT + 1) ? ACC_W : SHIFT + 1) + 1;
-  localparam integer QW = RW - SHIFT;                        // rounded value
   localparam integer TW = SECTIONS * DATA_W;                 // taps bus
 
   // ---- elaboration-time choice of the architecture -------------------------
@@ -207,9 +204,7 @@ module bandpass_sos #(
     // Folded: the final sum plus the rounding constant must fit AC (mod 2^AC is
     // exact then); with 32 bits or fewer SB_MAC16 holds the accumulator itself.
     localparam integer AWF = shared_acc_bits(1);
-    localparam integer ARW = ((AW > SHIFT + 1) ? AW : SHIFT + 1) + 1;
     localparam integer AC = FOLD ? ((AWF > SHIFT + 2) ? AWF : SHIFT + 2) : AW;
-    localparam integer AQW = FOLD ? AC - SHIFT : ARW - SHIFT;
     localparam integer XW = (AC > PW) ? AC : PW;
     localparam [AC+COEF_W-1:0] RNDW = (ROUNDING == 1 && SHIFT > 0)
                                       ? ({{(AC+COEF_W-1){1'b0}}, 1'b1} << (SHIFT - 1)) : {(AC+COEF_W){1'b0}};
@@ -462,45 +457,12 @@ module bandpass_sos #(
       end
       wire unused_diff = diff[0];
 
-      // ---- quantizer: acc (SHIFT more fraction bits) -> DATA_W -----------------
-      wire signed [AQW-1:0] qq;
+      // ---- quantizer: acc (SHIFT more fraction bits) -> DATA_W (rtl/fx_quantize.v) ----
+      // FOLD: the rounding constant is already in the sum, so the quantizer truncates.
       wire signed [DATA_W-1:0] y_new;
-      if (FOLD) begin : g_folded
-        assign qq = acc[AC-1:SHIFT];   // rounding constant already in the sum
-        if (SHIFT > 0) begin : g_lo
-          wire unused_acc_lo = &{1'b0, acc[SHIFT-1:0]};
-        end
-      end else begin : g_quant
-      wire signed [ARW-1:0] acc_r = {{(ARW - AW + 1){acc[AW-1]}}, acc[AW-2:0]};
-      if (SHIFT == 0) begin : g_noround
-        assign qq = acc_r;
-      end else begin : g_round
-        wire [ARW-1:0] rnd;
-        if (ROUNDING == 0) begin : g_trn
-          assign rnd = {ARW{1'b0}};
-        end else if (ROUNDING == 1) begin : g_rnd
-          assign rnd = {{(ARW - SHIFT){1'b0}}, 1'b1, {(SHIFT - 1){1'b0}}};
-        end else begin : g_conv
-          assign rnd = {{(ARW - SHIFT){1'b0}}, 1'b0, {(SHIFT - 1){1'b1}}}
-                     + {{(ARW - 1){1'b0}}, acc_r[SHIFT]};
-        end
-        wire [ARW-1:0] sum = acc_r + rnd;
-        assign qq = sum[ARW-1:SHIFT];
-        wire unused_round_bits = &{1'b0, sum[SHIFT-1:0]};
-      end
-      end
-      if (AQW > DATA_W) begin : g_ovf
-        wire fits = &qq[AQW-1:DATA_W-1] || ~|qq[AQW-1:DATA_W-1];
-        if (SATURATE != 0) begin : g_sat
-          assign y_new = fits ? qq[DATA_W-1:0]
-                       : (qq[AQW-1] ? {1'b1, {(DATA_W-1){1'b0}}} : {1'b0, {(DATA_W-1){1'b1}}});
-        end else begin : g_wrap
-          assign y_new = qq[DATA_W-1:0];
-          wire unused_fits = fits;
-        end
-      end else begin : g_noovf
-        assign y_new = {{(DATA_W - AQW + 1){qq[AQW-1]}}, qq[AQW-2:0]};
-      end
+      wire unused_fits;
+      fx_quantize #(.IN_W(AC), .OUT_W(DATA_W), .SHIFT(SHIFT), .ROUNDING(FOLD ? 0 : ROUNDING),
+                    .SATURATE(SATURATE)) u_quantize (.x(acc), .y(y_new), .fits(unused_fits));
       assign pair_y[i*DATA_W +: DATA_W] = y_new;
 
       // Writes: a's sum is final at r5, b's at r2; only for valid waves.
@@ -572,41 +534,11 @@ module bandpass_sos #(
         wire fire = link_valid[k] && can_take;
         wire write = ce && done;
 
-        // ---- quantizer: acc (SHIFT more fraction bits) -> DATA_W -----------------
-        wire signed [RW-1:0] acc_r = {{(RW - ACC_W + 1){acc[ACC_W-1]}}, acc[ACC_W-2:0]};
-        wire signed [QW-1:0] q;
+        // ---- quantizer: acc (SHIFT more fraction bits) -> DATA_W (rtl/fx_quantize.v) ----
         wire signed [DATA_W-1:0] y_new;
-        if (SHIFT == 0) begin : g_noround
-          assign q = acc_r;
-        end else begin : g_round
-          wire [RW-1:0] rnd;
-          if (ROUNDING == 0) begin : g_trn
-            assign rnd = {RW{1'b0}};
-          end else if (ROUNDING == 1) begin : g_rnd
-            assign rnd = {{(RW - SHIFT){1'b0}}, 1'b1, {(SHIFT - 1){1'b0}}};
-          end else begin : g_conv
-            // 2^(SHIFT-1) - 1 + lsb of the truncated result: a tie rounds up only
-            // to an even result, every other remainder like round-half-up.
-            assign rnd = {{(RW - SHIFT){1'b0}}, 1'b0, {(SHIFT - 1){1'b1}}}
-                       + {{(RW - 1){1'b0}}, acc_r[SHIFT]};
-          end
-          wire [RW-1:0] sum = acc_r + rnd;
-          assign q = sum[RW-1:SHIFT];
-          // The dropped fraction bits only matter through the carry into q.
-          wire unused_round_bits = &{1'b0, sum[SHIFT-1:0]};
-        end
-        if (QW > DATA_W) begin : g_ovf
-          wire fits = &q[QW-1:DATA_W-1] || ~|q[QW-1:DATA_W-1];
-          if (SATURATE != 0) begin : g_sat
-            assign y_new = fits ? q[DATA_W-1:0]
-                         : (q[QW-1] ? {1'b1, {(DATA_W-1){1'b0}}} : {1'b0, {(DATA_W-1){1'b1}}});
-          end else begin : g_wrap
-            assign y_new = q[DATA_W-1:0];
-            wire unused_fits = fits;
-          end
-        end else begin : g_noovf
-          assign y_new = {{(DATA_W - QW + 1){q[QW-1]}}, q[QW-2:0]};
-        end
+        wire unused_fits;
+        fx_quantize #(.IN_W(ACC_W), .OUT_W(DATA_W), .SHIFT(SHIFT), .ROUNDING(ROUNDING),
+                      .SATURATE(SATURATE)) u_quantize (.x(acc), .y(y_new), .fits(unused_fits));
 
         // Sign extension of the y history to the multiplier operand width.
         wire signed [DW-1:0] y1_x = {{(DW - DATA_W + 1){y1[DATA_W-1]}}, y1[DATA_W-2:0]};

@@ -336,46 +336,8 @@ module correlator_bank #(
     end
   endfunction
 
-  // Quantizers: round half up by SHIFT, saturate to the output width, at real widths. The
-  // saturation test is "the bits from the output's sign bit up are all equal" (a LUT tree), not
-  // two compares with MAX / MIN (two carry chains each); the result is the same.
-  localparam integer QM_W = imax(FP_W, MIX_W) + 1;
-  localparam integer QC_W = imax(FIR_W, CHIP_W) + 1;
-  localparam integer QR_W = imax(CA_W, CORR_W) + 1;
-  localparam [QM_W-1:0] ONE_M = 1;
-  localparam [QC_W-1:0] ONE_C = 1;
-  localparam [QR_W-1:0] ONE_R = 1;
-  localparam [QM_W-1:0] HALF_M = (MIX_SHIFT > 0) ? ONE_M << imax(MIX_SHIFT - 1, 0) : {QM_W{1'b0}};
-  localparam [QC_W-1:0] HALF_C = (CHIP_SHIFT > 0) ? ONE_C << imax(CHIP_SHIFT - 1, 0) : {QC_W{1'b0}};
-  localparam [QR_W-1:0] HALF_R = (CORR_SHIFT > 0) ? ONE_R << imax(CORR_SHIFT - 1, 0) : {QR_W{1'b0}};
-
-  function [MIX_W-1:0] q_mix;
-    input [FP_W-1:0] x;
-    reg signed [QM_W-1:0] t;
-    begin
-      t = $signed({{(QM_W-FP_W){x[FP_W-1]}}, x} + HALF_M) >>> MIX_SHIFT;
-      q_mix = (&t[QM_W-1:MIX_W-1] || ~|t[QM_W-1:MIX_W-1]) ? t[MIX_W-1:0]
-                                                    : {t[QM_W-1], {(MIX_W-1){~t[QM_W-1]}}};
-    end
-  endfunction
-  function [CHIP_W-1:0] q_chip;
-    input [FIR_W-1:0] x;
-    reg signed [QC_W-1:0] t;
-    begin
-      t = $signed({{(QC_W-FIR_W){x[FIR_W-1]}}, x} + HALF_C) >>> CHIP_SHIFT;
-      q_chip = (&t[QC_W-1:CHIP_W-1] || ~|t[QC_W-1:CHIP_W-1]) ? t[CHIP_W-1:0]
-                                                    : {t[QC_W-1], {(CHIP_W-1){~t[QC_W-1]}}};
-    end
-  endfunction
-  function [CORR_W-1:0] q_corr;
-    input [CA_W-1:0] x;
-    reg signed [QR_W-1:0] t;
-    begin
-      t = $signed({{(QR_W-CA_W){x[CA_W-1]}}, x} + HALF_R) >>> CORR_SHIFT;
-      q_corr = (&t[QR_W-1:CORR_W-1] || ~|t[QR_W-1:CORR_W-1]) ? t[CORR_W-1:0]
-                                                    : {t[QR_W-1], {(CORR_W-1){~t[QR_W-1]}}};
-    end
-  endfunction
+  // Quantizers q_mix / q_chip / q_corr: round half up by SHIFT, saturate to the output width
+  // (rtl/fx_quantize.v, instanced beside the node each one closes).
 
   // ================================================================ front end
   localparam [2:0] FE_IDLE = 3'd0, FE_M1 = 3'd1, FE_M2 = 3'd2, FE_M3 = 3'd3,
@@ -449,7 +411,10 @@ module correlator_bank #(
   assign s_ready = (fe_state == FE_IDLE) || hand;
   wire accept = s_valid && s_ready;
   wire [YA_W-1:0] y_ptr_next = (y_ptr == Y_LAST) ? {YA_W{1'b0}} : y_ptr + 1'b1;
-  wire [MIX_W-1:0] q_mix_fp = q_mix(fp);
+  wire [MIX_W-1:0] q_mix_fp;
+  wire unused_mix_fits;
+  fx_quantize #(.IN_W(FP_W), .OUT_W(MIX_W), .SHIFT(MIX_SHIFT), .ROUNDING(1), .SATURATE(1))
+    u_q_mix (.x(fp), .y(q_mix_fp), .fits(unused_mix_fits));
   wire signed [DATA_W-1:0] y_old = y_full ? y_rd : {DATA_W{1'b0}};
   wire signed [MIX_W-1:0]  b_old_re = b_full ? b_rd[2*MIX_W-1:MIX_W] : {MIX_W{1'b0}};
   wire signed [MIX_W-1:0]  b_old_im = b_full ? b_rd[MIX_W-1:0] : {MIX_W{1'b0}};
@@ -567,6 +532,10 @@ module correlator_bank #(
   reg [LBA_W-1:0] a_la;
   reg [LTB_W-1:0] a_lb;
   reg [FIR_W-1:0] facc;
+  wire [CHIP_W-1:0] q_chip_facc;
+  wire unused_chip_fits;
+  fx_quantize #(.IN_W(FIR_W), .OUT_W(CHIP_W), .SHIFT(CHIP_SHIFT), .ROUNDING(1), .SATURATE(1))
+    u_q_chip (.x(facc), .y(q_chip_facc), .fits(unused_chip_fits));
   reg             fq_pend, fq_lane;
   reg [CHIP_W-1:0] fres_re, fres_im;
   reg             fres_valid;
@@ -625,8 +594,12 @@ module correlator_bank #(
   wire [CA_W:0] ca_re_s = {ca_re, 1'b1} + {f_re_m, c_neg};
   wire [CA_W:0] ca_im_s = {ca_im, 1'b1} + {f_im_m, c_neg};
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [CORR_W-1:0] cq_re_n = q_corr(ca_re);
-  wire [CORR_W-1:0] cq_im_n = q_corr(ca_im);
+  wire [CORR_W-1:0] cq_re_n, cq_im_n;
+  wire unused_corr_re_fits, unused_corr_im_fits;
+  fx_quantize #(.IN_W(CA_W), .OUT_W(CORR_W), .SHIFT(CORR_SHIFT), .ROUNDING(1), .SATURATE(1))
+    u_q_corr_re (.x(ca_re), .y(cq_re_n), .fits(unused_corr_re_fits));
+  fx_quantize #(.IN_W(CA_W), .OUT_W(CORR_W), .SHIFT(CORR_SHIFT), .ROUNDING(1), .SATURATE(1))
+    u_q_corr_im (.x(ca_im), .y(cq_im_n), .fits(unused_corr_im_fits));
   wire b_start;
   wire f_write = b_start;
   always @(posedge clk) begin
@@ -821,7 +794,7 @@ module correlator_bank #(
       // ---------------- land
       if (fq_pend) begin
         fq_pend <= 1'b0;
-        fres_im <= q_chip(facc);  // re word first, moved to fres_re with the im word
+        fres_im <= q_chip_facc;  // re word first, moved to fres_re with the im word
         if (fq_lane) begin
           fres_re <= fres_im;
           fres_valid <= 1'b1;

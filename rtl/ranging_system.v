@@ -28,25 +28,26 @@
 /* verilator lint_off WIDTH */
 
 module ranging_system #(
-  parameter integer CLK_DIV = 6,
-  parameter integer ADC_W = 12,
-  parameter integer ADC_OFFSET_BINARY = 1,
-  parameter integer CODES = 9,
-  parameter integer CHIPS = 7,
-  parameter integer SPC = 100,
-  parameter integer CYC = 4,
-  parameter integer PERIOD_T = 1634,
-  parameter [CODES*CHIPS-1:0] CODE_BITS = 63'h6a42d8c44fa3ee53,
-  parameter integer CODE_W = 4,
-  parameter integer TIME_W = 40,
-  parameter integer FRAC_W = 8,
-  parameter integer SCORE_W = 16,
-  parameter integer OFF_W = 32,
-  parameter [CODES*OFF_W-1:0] OFFSETS = 288'h0003e8850003e7f90003e4610003e6f50003e6050003e8ad0003eb190003e7590003e691,
-  parameter integer C_FRAC = 16,
-  parameter [31:0] C_INIT = 32'd4456448,
-  parameter integer BAUD_DIV = 20,
-  parameter integer LED_HOLD = 1500000,
+  // Every default is the default configuration's (generated/default/rtl/ranging_system.vc).
+  parameter integer CLK_DIV = 6,              // system clocks per full-rate sample (fs = f_clk / CLK_DIV), >= 2
+  parameter integer ADC_W = 12,               // ADC word and receiver input width, bits
+  parameter integer ADC_OFFSET_BINARY = 1,    // 1: the ADC outputs straight binary; 0: two's complement
+  parameter integer CODES = 9,                // codes of the family, sent 1..CODES in turn
+  parameter integer CHIPS = 7,                // chips per code
+  parameter integer SPC = 100,                // full-rate samples per chip (CYC carrier cycles)
+  parameter integer CYC = 4,                  // carrier cycles per chip
+  parameter integer PERIOD_T = 1634,          // samples from one burst's start to the next's
+  parameter [CODES*CHIPS-1:0] CODE_BITS = 63'h6a42d8c44fa3ee53,  // chip m of code j at bit j*CHIPS + m, 1: +carrier
+  parameter integer CODE_W = 4,               // bits of a code number (1..CODES)
+  parameter integer TIME_W = 40,              // sample counters: wrap after 2^TIME_W samples
+  parameter integer FRAC_W = 8,               // fraction bits of arrival and time of flight
+  parameter integer SCORE_W = 16,             // detector score width (0..1 in SCORE_W-1 fraction bits)
+  parameter integer OFF_W = 32,               // width of one code's latency offset
+  parameter [CODES*OFF_W-1:0] OFFSETS = 288'h0003e8850003e7f90003e4610003e6f50003e6050003e8ad0003eb190003e7590003e691,  // receiver latency per code (tof_distance)
+  parameter integer C_FRAC = 16,              // fraction bits of the speed of sound register
+  parameter [31:0] C_INIT = 32'd4456448,      // speed of sound at reset, um per sample * 2^C_FRAC
+  parameter integer BAUD_DIV = 20,            // system clocks per UART bit
+  parameter integer LED_HOLD = 1500000,       // clocks the measurement LED stays on per frame
   // Sound-velocity compensation (rtl/sound_speed_cal.v): the calibration distance in um, 0: none
   // (the default and the committed bitstream: no logic, c_wr/c_value write C directly).
   parameter integer CAL_DIST_UM = 0

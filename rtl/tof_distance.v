@@ -47,19 +47,19 @@
 /* verilator lint_off WIDTH */
 
 module tof_distance #(
-  parameter integer CODES = 9,
-  parameter integer CODE_W = 4,
-  parameter integer TIME_W = 40,
-  parameter integer FRAC_W = 8,
-  parameter integer PERIOD_T = 1634,
-  parameter integer SCORE_W = 16,
-  parameter integer OFF_W = 32,
-  parameter [CODES*OFF_W-1:0] OFFSETS = 0,  // signed, FRAC_W fraction bits, code j (1-based) at [(j-1)*OFF_W +: OFF_W]
-  parameter integer C_W = 32,
-  parameter integer C_FRAC = 16,
-  parameter [C_W-1:0] C_INIT = 32'd4456448,  // 340 m/s at 5 MS/s: 68 um/sample * 2^16
-  parameter integer TOF_W = 32,
-  parameter integer DIST_W = 32
+  parameter integer CODES = 9,                 // codes sent in turn, 1..CODES
+  parameter integer CODE_W = 4,                // bits of a code number
+  parameter integer TIME_W = 40,               // sample index width (burst times, arrivals' integer part)
+  parameter integer FRAC_W = 8,                // fraction bits of arrival, offsets and ToF
+  parameter integer PERIOD_T = 1634,           // samples between consecutive bursts
+  parameter integer SCORE_W = 16,              // event score width (passed through to the result)
+  parameter integer OFF_W = 32,                // width of one latency offset
+  parameter [CODES*OFF_W-1:0] OFFSETS = 0,     // signed, FRAC_W fraction bits, code j (1-based) at [(j-1)*OFF_W +: OFF_W]
+  parameter integer C_W = 32,                  // speed of sound register width
+  parameter integer C_FRAC = 16,               // its fraction bits
+  parameter [C_W-1:0] C_INIT = 32'd4456448,    // 340 m/s at 5 MS/s: 68 um/sample * 2^16
+  parameter integer TOF_W = 32,                // ToF result width (saturated)
+  parameter integer DIST_W = 32                // distance result width, micrometres (saturated)
 ) (
   input  wire clk, rst,
   // transmit schedule (tx_scheduler)

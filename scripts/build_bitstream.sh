@@ -86,7 +86,7 @@ py=/usr/bin/python3
 ranging=${ranging:-"$build/tool/ranging"}
 [[ -x "$ranging" ]] || die "$ranging not found: build it first (cmake --build $build --target ranging)"
 
-receiver_rtl=("$root/rtl/bandpass_sos.v" "$root/rtl/correlator_bank.v" "$root/rtl/peak_detector.v")
+receiver_rtl=("$root/rtl/fx_quantize.v" "$root/rtl/bandpass_sos.v" "$root/rtl/correlator_bank.v" "$root/rtl/peak_detector.v")
 system_rtl=("$root/rtl/adc_interface.v" "$root/rtl/tx_scheduler.v" "$root/rtl/tof_distance.v"
             "$root/rtl/uart_tx.v" "$root/rtl/measurement_uart.v" "$root/rtl/ranging_system.v")
 for f in "${receiver_rtl[@]}" "${system_rtl[@]}"; do

@@ -20,7 +20,7 @@ while [ $# -ge 2 ]; do
   for kv in $sets; do args+=(--set "$kv"); done
   "$ranging" generate --config "$root/configs/default.yaml" "${args[@]}" --out "$dir/gen" > "$dir.gen.log" 2>&1
   reads=""
-  for m in bandpass_sos correlator_bank peak_detector; do reads+="read_verilog -defer $root/rtl/$m.v; "; done
+  for m in fx_quantize bandpass_sos correlator_bank peak_detector; do reads+="read_verilog -defer $root/rtl/$m.v; "; done
   reads+="read_verilog -defer -I$dir/gen/rtl $dir/gen/rtl/receiver_top.v; hierarchy -top receiver_top; "
   nice yosys -q -l "$dir/ice40.log" -p "$reads synth_ice40 -dsp -top receiver_top; tee -q -o $dir/ice40.txt stat" > /dev/null
   nice yosys -q -l "$dir/ecp5.log" -p "$reads synth_ecp5 -top receiver_top; tee -q -o $dir/ecp5.txt stat" > /dev/null

@@ -1,7 +1,7 @@
 # bandpass_sos: the Verilog SOS cascade against BandpassFixed (tb/tb_bandpass_sos.cpp), plus
 # its Verilator lint and an Icarus Verilog run of the same vectors.
 ranging_verilator_test(NAME tb_bandpass_sos TOP bandpass_sos
-  RTL ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v
+  RTL ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v ${RANGING_RTL_QUANTIZE}
   VC ${RANGING_GEN_DEFAULT}/rtl/bandpass_sos.vc
   TB ${CMAKE_CURRENT_SOURCE_DIR}/tb_bandpass_sos.cpp)
 find_program(RANGING_VERILATOR_LINT verilator REQUIRED)

@@ -7,8 +7,7 @@ target_include_directories(bench_receiver_top PRIVATE ${PROJECT_SOURCE_DIR})
 target_include_directories(bench_receiver_top SYSTEM PRIVATE ${VERILATOR_ROOT}/include ${VERILATOR_ROOT}/include/vltstd)
 target_compile_definitions(bench_receiver_top PRIVATE RANGING_CONFIG="${PROJECT_SOURCE_DIR}/configs/default.yaml")
 verilate(bench_receiver_top SOURCES ${RANGING_GEN_DEFAULT}/rtl/receiver_top.v
-  ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v ${PROJECT_SOURCE_DIR}/rtl/correlator_bank.v
-  ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v
+  ${RANGING_RECEIVER_RTL}
   TOP_MODULE receiver_top PREFIX Vreceiver_top
   # Bench build only (the equivalence testbenches keep their settings): X values resolved once
   # at compile time and initial values not randomized (scripts/bench.sh measures the choice).

@@ -1,7 +1,5 @@
 # The whole generated receiver against the golden model, stage by stage.
 ranging_verilator_test(NAME tb_receiver_top TOP receiver_top
   RTL ${RANGING_GEN_DEFAULT}/rtl/receiver_top.v
-      ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v
-      ${PROJECT_SOURCE_DIR}/rtl/correlator_bank.v
-      ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v
+      ${RANGING_RECEIVER_RTL}
   TB ${CMAKE_CURRENT_SOURCE_DIR}/tb_receiver_top.cpp)

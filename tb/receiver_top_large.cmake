@@ -2,9 +2,7 @@
 # same stage-by-stage testbench as the default.
 ranging_verilator_test(NAME tb_receiver_top_large TOP receiver_top COST 1000
   RTL ${PROJECT_SOURCE_DIR}/generated/large/rtl/receiver_top.v
-      ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v
-      ${PROJECT_SOURCE_DIR}/rtl/correlator_bank.v
-      ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v
+      ${RANGING_RECEIVER_RTL}
   TB ${CMAKE_CURRENT_SOURCE_DIR}/tb_receiver_top.cpp)
 target_compile_definitions(tb_receiver_top_large PRIVATE RANGING_TB_LARGE=1)
 # ranging_verilator_test defines RANGING_CONFIG as the default; the large one wins (last -D).

@@ -19,9 +19,6 @@ set(RANGING_SYSTEM_RTL
   ${PROJECT_SOURCE_DIR}/rtl/adc_interface.v ${PROJECT_SOURCE_DIR}/rtl/tx_scheduler.v
   ${PROJECT_SOURCE_DIR}/rtl/tof_distance.v ${PROJECT_SOURCE_DIR}/rtl/uart_tx.v
   ${PROJECT_SOURCE_DIR}/rtl/measurement_uart.v ${PROJECT_SOURCE_DIR}/rtl/ranging_system.v)
-set(RANGING_RECEIVER_RTL
-  ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v ${PROJECT_SOURCE_DIR}/rtl/correlator_bank.v
-  ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v)
 
 if(EXISTS ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v AND EXISTS ${RANGING_SYSTEM_TB_VC})
   ranging_verilator_test(NAME tb_ranging_system TOP ranging_system
@@ -39,15 +36,8 @@ if(RANGING_YOSYS_BIN AND RANGING_PS_VERILATOR AND EXISTS ${PROJECT_SOURCE_DIR}/r
   get_filename_component(RANGING_YOSYS_PREFIX ${RANGING_YOSYS_BIN} DIRECTORY)
   find_path(RANGING_YOSYS_DATDIR ice40/cells_sim.v HINTS ${RANGING_YOSYS_PREFIX}/../share/yosys
             /usr/share/yosys /usr/local/share/yosys REQUIRED)
-  add_executable(tb_postsynth ${CMAKE_CURRENT_SOURCE_DIR}/tb_postsynth.cpp)
-  set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/tb_postsynth.cpp PROPERTIES
-    COMPILE_OPTIONS "$<$<BOOL:${RANGING_WERROR}>:-Werror>")
-  target_link_libraries(tb_postsynth PRIVATE ranging_model GTest::gtest GTest::gtest_main)
-  target_include_directories(tb_postsynth PRIVATE ${PROJECT_SOURCE_DIR})
+  ranging_tb_executable(tb_postsynth ${CMAKE_CURRENT_SOURCE_DIR}/tb_postsynth.cpp)
   target_compile_definitions(tb_postsynth PRIVATE
-    RANGING_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-    RANGING_GENERATED_DIR="${RANGING_GEN_DEFAULT}"
-    RANGING_CONFIG="${PROJECT_SOURCE_DIR}/configs/default.yaml"
     RANGING_YOSYS_BIN="${RANGING_YOSYS_BIN}"
     RANGING_YOSYS_DATDIR="${RANGING_YOSYS_DATDIR}"
     RANGING_VERILATOR_BIN="${RANGING_PS_VERILATOR}"

@@ -13,9 +13,7 @@ target_compile_definitions(sc_receiver_top PRIVATE RANGING_CONFIG="${PROJECT_SOU
 add_dependencies(sc_receiver_top generated_default)
 verilate(sc_receiver_top SYSTEMC
   SOURCES ${RANGING_GEN_DEFAULT}/rtl/receiver_top.v
-          ${PROJECT_SOURCE_DIR}/rtl/bandpass_sos.v
-          ${PROJECT_SOURCE_DIR}/rtl/correlator_bank.v
-          ${PROJECT_SOURCE_DIR}/rtl/peak_detector.v
+          ${RANGING_RECEIVER_RTL}
   TOP_MODULE receiver_top PREFIX Vreceiver_top
   VERILATOR_ARGS -Wno-fatal)
 verilator_link_systemc(sc_receiver_top)

@@ -345,7 +345,11 @@ ParamList params_for(const BandpassFixed& m, int sample_cycles) {
           {"SAMPLE_CYCLES", std::to_string(sample_cycles)}};
 }
 
-std::string rtl_path() { return std::string(RANGING_SOURCE_DIR) + "/rtl/bandpass_sos.v"; }
+// The module and the quantizer it instantiates.
+std::string rtl_path() {
+  const std::string rtl = std::string(RANGING_SOURCE_DIR) + "/rtl/";
+  return rtl + "bandpass_sos.v " + rtl + "fx_quantize.v";
+}
 
 CmdResult lint(const ParamList& params) {
   std::string cmd = std::string(RANGING_VERILATOR_BIN) + " --lint-only -Wall --top-module bandpass_sos";

@@ -487,7 +487,9 @@ std::string slurp(const std::string& path) {
 }
 
 const std::string kVc = std::string(RANGING_GENERATED_DIR) + "/rtl/correlator_bank.vc";
-const std::string kRtl = std::string(RANGING_SOURCE_DIR) + "/rtl/correlator_bank.v";
+// The module and the quantizer it instantiates.
+const std::string kRtl =
+    std::string(RANGING_SOURCE_DIR) + "/rtl/correlator_bank.v " + std::string(RANGING_SOURCE_DIR) + "/rtl/fx_quantize.v";
 
 TEST(CorrelatorBankRtl, VerilatorLintIsClean) {
   const std::string log = std::string(RANGING_TRACE_DIR) + "/tb_correlator_bank_lint.log";

@@ -20,6 +20,7 @@
 #include "model/sim/channel.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/hw/hw_params.hpp"
+#include "model/hw/ip_package.hpp"
 #include "model/dsp/receiver.hpp"
 #include "tb/bits.hpp"
 
@@ -117,10 +118,8 @@ TEST(PostSynthesis, NetlistMatchesGoldenModel) {
   const std::string gen = RANGING_GENERATED_DIR;
   const std::string src = RANGING_SOURCE_DIR;
   std::string reads;
-  for (const std::string& f : {src + "/rtl/bandpass_sos.v", src + "/rtl/correlator_bank.v",
-                              src + "/rtl/peak_detector.v", gen + "/rtl/receiver_top.v"}) {
-    reads += "read_verilog -defer " + f + "; ";
-  }
+  for (const std::string& f : receiver_rtl_sources()) reads += "read_verilog -defer " + src + "/rtl/" + f + "; ";
+  reads += "read_verilog -defer " + gen + "/rtl/receiver_top.v; ";
   const fs::path netlist = work / "receiver_top_syn.v";
   ASSERT_EQ(run("nice " RANGING_YOSYS_BIN " -q -l " + (work / "yosys.log").string() + " -p '" + reads +
                 "synth_ice40 -dsp -top receiver_top; tee -q -o " + (work / "stat.txt").string() +

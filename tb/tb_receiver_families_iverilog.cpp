@@ -18,6 +18,7 @@
 #include "model/dsp/excitation.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
+#include "model/hw/ip_package.hpp"
 #include "model/dsp/receiver.hpp"
 
 using namespace ranging;
@@ -165,10 +166,9 @@ TEST_P(ReceiverFamiliesIcarus, EveryCodeDecodesIdenticallyToTheModel) {
     for (auto v : x) hex << std::hex << (static_cast<std::uint64_t>(v) & ((1u << w) - 1)) << "\n";
     std::ofstream(dir / "bench.v") << bench(d, x.size());
   }
-  const std::string src = std::string(RANGING_SOURCE_DIR) + "/rtl/";
-  const std::string cmd = "cd " + dir.string() + " && iverilog -g2012 -s iv_top -o sim.vvp bench.v rtl/receiver_top.v " +
-                          src + "bandpass_sos.v " + src + "correlator_bank.v " + src + "peak_detector.v > build.log 2>&1" +
-                          " && vvp -n sim.vvp > run.log 2>&1";
+  std::string cmd = "cd " + dir.string() + " && iverilog -g2012 -s iv_top -o sim.vvp bench.v rtl/receiver_top.v";
+  for (const auto& f : receiver_rtl_sources()) cmd += " " + std::string(RANGING_SOURCE_DIR) + "/rtl/" + f;
+  cmd += " > build.log 2>&1 && vvp -n sim.vvp > run.log 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << "see " << dir.string() << "/build.log and run.log";
 
   std::ifstream ev(dir / "events.txt");

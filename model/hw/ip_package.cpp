@@ -122,7 +122,7 @@ std::string core_file(const ReceiverDesign& d, const std::string& core, const st
 }  // namespace
 
 const std::vector<std::string>& receiver_rtl_sources() {
-  static const std::vector<std::string> v{"bandpass_sos.v", "correlator_bank.v", "peak_detector.v"};
+  static const std::vector<std::string> v{"fx_quantize.v", "bandpass_sos.v", "correlator_bank.v", "peak_detector.v"};
   return v;
 }
 

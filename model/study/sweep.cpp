@@ -20,6 +20,7 @@
 #include "model/dsp/stability.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
+#include "model/hw/ip_package.hpp"
 #include "model/hw/realtime.hpp"
 #include "model/sim/capture.hpp"
 #include "model/sim/scene.hpp"
@@ -292,9 +293,8 @@ namespace {
 // Resources of the generated receiver top for one target (yosys), cached by the hash of the
 // generated RTL, the module sources and the target's script.
 json synthesize(const std::map<std::string, std::string>& files, const PointOptions& o, const SynthTarget& target) {
-  const std::vector<std::string> modules = {"bandpass_sos.v", "correlator_bank.v", "peak_detector.v"};
   std::string all = files.at("rtl/receiver_top.v");
-  for (const auto& m : modules) all += slurp(o.source_dir + "/rtl/" + m);
+  for (const auto& m : receiver_rtl_sources()) all += slurp(o.source_dir + "/rtl/" + m);
   // iCE40 keeps the hash of earlier sweeps (their caches stay valid); other targets add their script.
   if (std::string(target.name) != "ice40") all += target.script;
   const std::string hash = hex16(fnv1a(all));
@@ -321,7 +321,7 @@ json synthesize(const std::map<std::string, std::string>& files, const PointOpti
     std::ofstream(work + "/" + fs::path(name).filename().string()) << text;
   }
   std::string cmd = "cd '" + work + "' && nice yosys -q -l yosys.log -p '";
-  for (const auto& m : modules) cmd += "read_verilog -defer " + o.source_dir + "/rtl/" + m + "; ";
+  for (const auto& m : receiver_rtl_sources()) cmd += "read_verilog -defer " + o.source_dir + "/rtl/" + m + "; ";
   cmd += "read_verilog -defer -I. receiver_top.v; hierarchy -top receiver_top; " + std::string(target.script) +
          "; tee -q -o stat.txt stat' > /dev/null 2>&1";
   const auto t0 = std::chrono::steady_clock::now();
