@@ -129,6 +129,31 @@ std::vector<std::string> Parser::values(const std::string& name) const {
   return out;
 }
 
+std::vector<std::string> Parser::items(const std::string& name) const {
+  std::vector<std::string> out;
+  std::stringstream ss(get(name).value_or(""));
+  std::string item;
+  while (std::getline(ss, item, ',')) out.push_back(item);
+  return out;
+}
+
+std::vector<double> Parser::number_list(const std::string& name) const {
+  std::vector<double> out;
+  for (const std::string& item : items(name)) out.push_back(list_number(name, item));
+  return out;
+}
+
+double list_number(const std::string& option, const std::string& item) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(item, &used);
+    if (used != item.size()) throw std::invalid_argument(item);
+    return v;
+  } catch (const std::exception&) {
+    throw InputError("option " + option + ": '" + item + "' is not a number");
+  }
+}
+
 std::string Parser::get_or(const std::string& name, const std::string& fallback) const {
   return get(name).value_or(fallback);
 }

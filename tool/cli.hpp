@@ -35,6 +35,10 @@ class Parser {
   std::string required(const std::string& name) const;
   // Every value of a repeatable option, in order (e.g. --set KEY=VALUE --set ...).
   std::vector<std::string> values(const std::string& name) const;
+  // The comma-separated items of an option (--distances 0.1,0.55,1.0), value or default, in order.
+  std::vector<std::string> items(const std::string& name) const;
+  // ... each as a number (list_number).
+  std::vector<double> number_list(const std::string& name) const;
   // Numeric options: validated to be finite and within [lo, hi]; the error names the option.
   double number(const std::string& name, double fallback, double lo, double hi) const;
   long long integer(const std::string& name, long long fallback, long long lo, long long hi) const;
@@ -60,5 +64,9 @@ class Parser {
   std::vector<std::pair<std::string, std::string>> given_;  // name -> value ("" for flags)
   std::vector<std::string> positionals_;
 };
+
+// An item of a comma-separated option (Parser::items) as a number, the whole item in std::stod
+// syntax; else InputError "option OPTION: 'ITEM' is not a number".
+double list_number(const std::string& option, const std::string& item);
 
 }  // namespace cli

@@ -28,7 +28,7 @@
 #include "tool/build_info.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
-#include "tool/guard.hpp"
+#include "tool/options.hpp"
 #include "tool/rtl_runner.hpp"
 #include "tool/shell.hpp"
 
@@ -106,17 +106,9 @@ fs::path self_exe() {
 }  // namespace
 
 int cmd_bitstream(const Args& args) {
-  cli::Parser p("ranging bitstream",
-                "Build the iCEBreaker (iCE40UP5K-SG48) bitstream of the ranging system for a receiver\n"
-                "configuration with the open flow (generate, yosys synth_ice40, nextpnr-ice40, icepack,\n"
-                "icetime: scripts/build_bitstream.sh), and optionally program the board. The netlists,\n"
-                "logs, the .bin and the summary (results/bitstream.json and .md) go into --out; progress\n"
-                "goes to stderr, the summary to stdout.\n"
-                "Exit status: 0 built (and programmed), 1 --check and a target missed, 2 bad input, a\n"
-                "missing tool, or --program with no programmer installed or no board attached (checked\n"
-                "before anything is built).");
-  p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md); its system: section sets clock, UART, speed of sound");
-  p.option("--set", "KEY=VALUE", "override a key of the configuration (repeatable), as in ranging generate");
+  cli::Parser p = command_parser("bitstream");
+  add_config_options(p, {.required = true, .writes_effective = true,
+                         .config_note = "; its system: section sets clock, UART, speed of sound"});
   p.option("--board", "NAME", "target board; valid: icebreaker", "icebreaker");
   p.option("--seeds", "N", "place and route with nextpnr seeds 1..N and keep the fastest (1-99)", "1");
   p.option("--jobs", "N", "seeds placed and routed at the same time (1-99)", "1");
@@ -125,7 +117,6 @@ int cmd_bitstream(const Args& args) {
   p.flag("--estimates", "also estimate ECP5 and Xilinx 7 resources of this configuration with yosys");
   p.flag("--program", "write the bitstream into the board's flash (iceprog or openFPGALoader)");
   p.option("--bin", "FILE", "with --program: program this bitstream, build nothing");
-  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
   const std::string board = p.get_or("--board", "icebreaker");
   if (board != "icebreaker") throw InputError("option --board: '" + board + "' is not supported; valid: icebreaker");
@@ -145,16 +136,14 @@ int cmd_bitstream(const Args& args) {
     return 0;
   }
 
-  const auto config = p.get("--config");
-  if (!config) throw InputError("option --config is required");
-  const Overrides overrides = parse_overrides(p.values("--set"));
-  const ReceiverConfig cfg = load_receiver_config(*config, overrides, p.has("--allow-out-of-spec"));
-  warn_if_out_of_spec("bitstream", cfg);
+  const std::string config = p.required("--config");
+  Overrides overrides;
+  const ReceiverConfig cfg = load_config_options(p, "bitstream", &overrides);
   check_generatable(cfg);
   try {  // the system design (period, UART divider, calibration) before minutes of synthesis
     (void)system_design(design_receiver(cfg));
   } catch (const InputError& e) {
-    throw InputError(locate_in_config(*config, e.what()));
+    throw InputError(locate_in_config(config, e.what()));
   }
   const fs::path out = fs::absolute(p.get_or("--out", default_work_dir("bitstream", cfg.name).string()));
   {
@@ -173,7 +162,7 @@ int cmd_bitstream(const Args& args) {
   if (do_program) prog = find_board();  // fail before the flow, not after it
 
   fs::create_directories(out);
-  std::string config_path = fs::absolute(*config).string();
+  std::string config_path = fs::absolute(config).string();
   if (!overrides.empty()) {  // the effective configuration, as generate --set writes it
     config_path = (out / "config.yaml").string();
     std::ofstream f(config_path);
@@ -216,7 +205,7 @@ int cmd_bitstream(const Args& args) {
   }
   const fs::path bin = out / "ranging_icebreaker.bin";
   if (do_program) program(prog, bin.string());
-  std::cout << "configuration " << cfg.name << " (" << *config << "), board " << board << "\n"
+  std::cout << "configuration " << cfg.name << " (" << config << "), board " << board << "\n"
             << "LUT4 " << ic.value("lut4", 0) << " / 5280, SB_MAC16 " << ic.value("sb_mac16", 0) << " / 8, EBR "
             << ic.value("ebr", 0) << " / 30\n";
   if (routed) {

@@ -12,6 +12,7 @@
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -114,20 +115,13 @@ int print_msequence(int degree, std::uint32_t poly, bool json) {
 }  // namespace
 
 int cmd_codes(const Args& args) {
-  cli::Parser p("ranging codes (--list | --family NAME | --degree N [--poly 0xHEX]) [--json]",
-                "Print the spreading codes: the paper's families M1..M4 and Gold1..Gold7 "
-                "(Tables 1-3), generic families mseq-N and gold-N, or one LFSR m-sequence.\n"
-                "Polynomial mask: bit k is the coefficient of x^k (0x13 = x^4 + x + 1).");
+  cli::Parser p = command_parser("codes");
   p.flag("--list", "one line per family: name, length, eta, description");
-  p.option("--family", "NAME", "print every code of a family, e.g. M1 or Gold4");
+  add_family_option(p, "print every code of it");
   p.option("--degree", "N", "print one m-sequence of this degree (2..16)");
   p.option("--poly", "0xHEX", "feedback polynomial for --degree (default: the table's primitive one)");
-  p.flag("--json", "machine-readable output");
+  add_output_options(p, {.json = true});
   if (!p.parse(args)) return 0;
-  if (!p.positionals().empty()) {
-    throw InputError("unexpected argument '" + p.positionals().front() +
-                     "'; use --list, --family NAME or --degree N");
-  }
 
   const int modes = int(p.has("--list")) + int(p.has("--family")) + int(p.has("--degree"));
   if (modes != 1) {

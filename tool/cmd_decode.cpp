@@ -24,6 +24,7 @@
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/options.hpp"
 #include "tool/plot.hpp"
 
 namespace ranging::tool {
@@ -98,33 +99,19 @@ void plot_decode(const std::string& png, const Scene& scene, const std::string& 
 }  // namespace
 
 int cmd_decode(const Args& args) {
-  cli::Parser p("ranging decode",
-                "Decode a capture: oscilloscope CSV (header lines, then rows 'time_s,volts') or WAV\n"
-                "(16/24-bit PCM, 32-bit float), t = 0 at the start of transmission of the first\n"
-                "burst. The receiver (bandpass, correlator bank, peak detector) adapts to the file's\n"
-                "sample rate (it must be an integer multiple of the 200 kHz carrier); its latency and\n"
-                "the Pearson references are simulated with the calibrated transducers (docs/scenes.md)\n"
-                "unless --references gives recorded ones (DIR/<family>-<j>.csv or .wav); --calibrate\n"
-                "corrects the latency with a capture at a known --distance. The Pearson decoder is the\n"
-                "paper's matched filter (each reference's best rho over lags within +-L chips).\n"
-                "Metadata in the capture (CSV header lines or a sidecar STEM.json, as `simulate\n"
-                "--write-captures` writes) supply the family, speed of sound and burst period unless an\n"
-                "option overrides them; the output says which was used.\n"
-                "Exit status: 0 at least one burst passed the --min-rho gate; 1 nothing passed it\n"
-                "(bursts below the gate are still listed, with their rho); 2 bad input.");
+  cli::Parser p = command_parser("decode");
   p.positional("CAPTURE", "capture file (.csv or .wav)");
-  p.option("--family", "NAME", "code family the transmitter used (ranging codes --list); default: the capture's metadata");
+  add_family_option(p, "the one the transmitter used; default: the capture's metadata");
   p.option("--references", "DIR", "recorded reference bursts DIR/<family>-<j>.csv|.wav for the Pearson decoder");
-  p.option("--speed-of-sound", "M/S", "speed of sound, 100..10000 (default: the capture's metadata, else 340)");
+  add_speed_of_sound_option(p, "the capture's metadata, else 340");
   p.option("--temperature", "C", "air temperature -40..60 C: speed of sound at 50 % RH, 101.325 kPa");
   p.option("--period", "S", "bursts were sent every S seconds, codes 1..eta in turn (default: the capture's metadata, else one burst per code, all at t = 0)");
   p.option("--min-rho", "R", "report bursts whose Pearson rho_max (eq. 9) is at least R, 0..1 (noise triggers score lower)", "0.7");
-  p.option("--set", "KEY=VALUE", "override a key of the decoding scene built from the options (repeatable), e.g. receiver.config.detector.threshold=0.5 (docs/scenes.md)");
-  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
+  add_scene_overrides(p, "the decoding scene built from the options");
   p.option("--calibrate", "FILE", "a capture of the same transducers at the known --distance (one burst per code at t = 0, or a train with its period in its metadata): corrects the receiver latency per code, the mean for codes it lacks");
   p.option("--distance", "M", "the distance of the --calibrate capture, 0.001..1000 m");
   p.option("--plot", "FILE.png", "draw the capture, the bandpass output and the bank's rho^2 per code with the detections");
-  p.flag("--json", "machine-readable output");
+  add_output_options(p, {.json = true});
   p.option("--block-samples", "N", "the capture is streamed in blocks of N samples, 64..67108864 (memory, not results, depends on it)", "1048576");
   if (!p.parse(args)) return 0;
   const std::string path = p.positionals().at(0);
@@ -155,7 +142,7 @@ int cmd_decode(const Args& args) {
   }
   Setting c{340.0, "default (340 m/s, the paper's)"};
   if (p.has("--speed-of-sound")) {
-    c = {p.number("--speed-of-sound", 340, 100, 10000), "option --speed-of-sound"};
+    c = {speed_of_sound_option(p), "option --speed-of-sound"};
   } else if (p.has("--temperature")) {
     AirConditions a;
     a.temperature_c = p.number("--temperature", 20, -40, 60);

@@ -5,69 +5,34 @@
 
 #include <cstdio>
 #include <iostream>
-#include <sstream>
 
 #include "model/config/receiver_config.hpp"
 #include "model/sim/demo.hpp"
 #include "model/base/error.hpp"
 #include "tool/cli.hpp"
-#include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
-namespace {
-
-std::vector<double> parse_list(const std::string& option, const std::string& text) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      out.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw InputError("option " + option + ": '" + item + "' is not a number");
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 int cmd_demo(const Args& args) {
-  cli::Parser p("ranging demo",
-                "Encode every code of a family, send it through a simple channel (delay at the\n"
-                "speed of sound, 1/d spreading, resonant transducers, white noise), filter and\n"
-                "decode it with the float and the bit-accurate fixed-point receiver, and print per\n"
-                "code: sent, decoded, ToF, distance, error, and the paper's u (eq. 12).");
-  p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md)");
-  p.option("--family", "NAME", "code family (overrides the configuration's)", "Gold4");
+  cli::Parser p = command_parser("demo");
+  add_config_options(p);
+  add_family_option(p, "overrides the configuration's", "Gold4");
   p.option("--distances", "LIST", "comma-separated distances in metres, 0.01..20", "0.1,0.55,1.0");
-  p.option("--speed-of-sound", "M/S", "speed of sound, 100..10000", "340");
+  add_speed_of_sound_option(p);
   p.option("--gain", "FS", "received amplitude at 0.1 m in ADC full-scale units, 1e-6..10", "0.5");
   p.option("--noise-rms", "FS", "white noise rms at the ADC in full-scale units, 0..10", "0.002");
   p.option("--seed", "N", "noise seed", "1");
-  p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): correlator_fixed.chip_bits=18, filter.type=ellip (of --config, else of the built-in default)");
-  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
-  p.flag("--json", "machine-readable output");
-  p.flag("--quiet", "no progress on stderr");
+  add_output_options(p, {.json = true, .quiet = true});
   if (!p.parse(args)) return 0;
 
   DemoParams d;
-  const Overrides overrides = parse_overrides(p.values("--set"));
-  const bool allow = p.has("--allow-out-of-spec");
-  if (auto cfg = p.get("--config"); cfg && p.has("--config")) {
-    d.receiver = load_receiver_config(*cfg, overrides, allow);
-  } else {
-    d.receiver = default_receiver_config(overrides);
-  }
-  d.receiver.allow_out_of_spec = allow;
+  d.receiver = load_config_options(p, "demo");
   if (p.has("--family") || !p.has("--config")) d.receiver.family = p.get_or("--family", "Gold4");
-  warn_if_out_of_spec("demo", d.receiver);
-  d.distances_m = parse_list("--distances", p.get_or("--distances", ""));
-  d.speed_of_sound = p.number("--speed-of-sound", 340, 100, 10000);
+  d.distances_m = p.number_list("--distances");
+  d.speed_of_sound = speed_of_sound_option(p);
   d.gain = p.number("--gain", 0.5, 1e-6, 10);
   d.noise_rms = p.number("--noise-rms", 0.002, 0, 10);
   d.seed = static_cast<std::uint64_t>(p.integer("--seed", 1, 0, 1LL << 62));

@@ -10,16 +10,13 @@
 #include "model/sim/scene_simulator.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
 
 int cmd_doppler(const Args& args) {
-  cli::Parser p("ranging doppler",
-                "Send every code of the scene's family between a fixed TX and an RX moving along the common\n"
-                "axis at constant line-of-sight speeds (closing > 0), decode each burst with the scene's\n"
-                "receiver and report the decode rate and the ToF bias (docs/results/blade-crossing.md).\n"
-                "The scene needs excitation.schedule.period_s (the codes' send times).");
-  p.positional("SCENE", "scene file (YAML), static or rotor");
+  cli::Parser p = command_parser("doppler");
+  add_scene_argument(p);
   p.option("--speeds", "LIST", "comma-separated line-of-sight speeds, m/s", "0,10,20,40,80");
   p.option("--distance", "M", "distance at the burst centre's arrival, m", "0.5");
   p.option("--repeats", "N", "repeats of every code", "3");
@@ -32,23 +29,12 @@ int cmd_doppler(const Args& args) {
   const double d = p.number("--distance", 0.5, 0.01, 20.0);
   const int repeats = static_cast<int>(p.number("--repeats", 3, 1, 1000));
   std::vector<double> speeds;
-  {
-    std::stringstream ss(*p.get("--speeds"));
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-      double v = 0;
-      try {
-        std::size_t used = 0;
-        v = std::stod(item, &used);
-        if (used != item.size()) throw std::invalid_argument(item);
-      } catch (const std::exception&) {
-        throw InputError("option --speeds: '" + item + "' is not a number");
-      }
-      if (!(v > -0.9 * scene.speed() && v < 0.9 * scene.speed())) {
-        throw InputError("option --speeds: " + item + " m/s is out of range; valid range is (-0.9 c, 0.9 c)");
-      }
-      speeds.push_back(v);
+  for (const std::string& item : p.items("--speeds")) {
+    const double v = cli::list_number("--speeds", item);
+    if (!(v > -0.9 * scene.speed() && v < 0.9 * scene.speed())) {
+      throw InputError("option --speeds: " + item + " m/s is out of range; valid range is (-0.9 c, 0.9 c)");
     }
+    speeds.push_back(v);
   }
   SceneSimulator sim(scene);
   std::ostringstream csv;

@@ -498,14 +498,10 @@ std::string figures_section(const std::vector<std::string>& figures, const std::
 }  // namespace
 
 int cmd_evaluate(const Args& args) {
-  cli::Parser p("ranging evaluate",
-                "Reproduce the paper's Section 4 from a scene: Table 4 (u_min, Energy_min), Table 5\n"
-                "(T_d-max), Table 6 (v_max), Figures 13-15 (PNG via scripts/plot_section4.py) and a\n"
-                "generated Markdown document comparing the paper's values with ours.");
-  p.positional("SCENE", "scene file, e.g. scenes/paper-section4.yaml");
-  p.option("--out", "DIR", "output directory (default: out/<scene name>; the committed results: --out docs/results)");
+  cli::Parser p = command_parser("evaluate");
+  add_output_options(p, {.out = true, .out_default = "out/<scene name>; the committed results: --out docs/results",
+                         .json = true, .json_note = "the tables as JSON on stdout", .quiet = true});
   p.flag("--no-plots", "skip the PNG figures (no Python needed)");
-  p.flag("--json", "print the tables as JSON on stdout");
   add_scene_options(p);
   if (!p.parse(args)) return 0;
   const std::string scene_path = p.positionals().at(0);

@@ -24,6 +24,7 @@
 #include "tool/commands.hpp"
 #include "tool/guard.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -106,10 +107,7 @@ void plot_response(const std::string& png, const SosFilter& filter, const SosFil
 }  // namespace
 
 int cmd_filter(const Args& args) {
-  cli::Parser p("ranging filter",
-                "Design the bandpass IIR filter (analog prototype -> bandpass -> bilinear, as\n"
-                "scipy/MATLAB) and print its second-order sections. Defaults are the paper's\n"
-                "spec (section 3.3.1).");
+  cli::Parser p = command_parser("filter");
   p.option("--type", "TYPE", "butter | cheby1 | ellip", "butter");
   p.option("--fp1", "HZ", "lower passband edge", "150000");
   p.option("--fp2", "HZ", "upper passband edge", "250000");
@@ -123,7 +121,7 @@ int cmd_filter(const Args& args) {
   p.option("--coef-frac", "F", "coefficient fraction bits, 0..62 (default: B-2)");
   p.option("--plot", "FILE.png", "draw |H(f)| of the float and the quantized design over the spec mask");
   p.flag("--allow-out-of-spec", "print a design whose quantized filter is unstable or out of spec (exit 0)");
-  p.flag("--json", "machine-readable output");
+  add_output_options(p, {.json = true});
   if (!p.parse(args)) return 0;
 
   const FilterType type = [&] {

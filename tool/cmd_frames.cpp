@@ -25,6 +25,7 @@
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -118,16 +119,13 @@ class PortDecoder {
 }  // namespace
 
 int cmd_frames(const Args& args) {
-  cli::Parser p("ranging frames",
-                "Decode the board's UART stream (17-byte measurement frames, docs/bitstream.md) from FILE\n"
-                "or stdin (-): one CSV row per good frame (or --json). Checksums are checked; after a\n"
-                "corrupt byte the decoder resyncs on the next 0xA5 0x5A; bad frames are counted.");
+  cli::Parser p = command_parser("frames");
   p.positional("FILE", "captured bytes (binary), or - for stdin (not with --port)", false);
   p.option("--port", "DEV", "read the serial port DEV (e.g. /dev/ttyUSB1) instead of FILE: raw 8N1");
   p.option("--baud", "B", "with --port: the line rate (the board's: 1500000)", "1500000");
   p.option("--frames", "N", "with --port: stop after N good frames (default: no limit)");
   p.option("--timeout", "S", "with --port: stop after S seconds without a byte (default: none)");
-  p.flag("--json", "JSON instead of CSV");
+  add_output_options(p, {.json = true, .json_note = "JSON instead of CSV"});
   p.flag("--strict", "exit 1 when any frame was bad or truncated");
   if (!p.parse(args)) return 0;
   const bool port = p.has("--port");

@@ -10,25 +10,18 @@
 #include "model/hw/ip_package.hpp"
 #include "tool/build_info.hpp"
 #include "tool/cli.hpp"
-#include "tool/guard.hpp"
 #include "tool/commands.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
 
 int cmd_generate(const Args& args) {
-  cli::Parser p("ranging generate",
-                "Generate the self-contained IP folder of the receiver described by a configuration\n"
-                "file: the Verilog top and parameters, copies of every RTL source it needs, the HLS\n"
-                "C++ and its configuration header, filelists (files.f: receiver_top, system.f: the\n"
-                "ranging system), a README of the ports, a FuseSoC CAPI2 .core file and a GTKWave\n"
-                "save file. The output folder is replaced atomically: on error nothing is written.");
-  p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md)");
-  p.option("--out", "DIR", "output folder");
-  p.option("--rtl", "DIR", "take the RTL sources from DIR instead of the project's rtl/");
+  cli::Parser p = command_parser("generate");
+  add_config_options(p, {.required = true, .writes_effective = true});
+  add_output_options(p, {.out = true});
+  add_rtl_option(p);
   p.option("--origin", "NAME", "name of the configuration in the generated banners (default: FILE as given)");
-  p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): correlator_fixed.chip_bits=18, filter.type=ellip; the effective configuration is written as DIR/config.yaml");
   p.flag("--no-sources", "write only the configuration-dependent files (tops, parameters, HLS configuration, manifest, README): no copies of rtl/ and hls/, no filelists, no .core; the form committed in generated/");
-  p.flag("--allow-out-of-spec", kAllowOutOfSpecHelp);
   if (!p.parse(args)) return 0;
   const std::string config = p.required("--config");
   const std::string out = p.required("--out");
@@ -38,9 +31,8 @@ int cmd_generate(const Args& args) {
       throw InputError("option --out: '" + out + "' exists and is not a folder; expected a folder");
     }
   }
-  const Overrides overrides = parse_overrides(p.values("--set"));
-  const ReceiverConfig cfg = load_receiver_config(config, overrides, p.has("--allow-out-of-spec"));
-  warn_if_out_of_spec("generate", cfg);
+  Overrides overrides;
+  const ReceiverConfig cfg = load_config_options(p, "generate", &overrides);
   check_generatable(cfg);  // cheap checks first: the design of a large family takes time
   const ReceiverDesign design = design_receiver(cfg);
   std::map<std::string, std::string> files;
@@ -49,7 +41,7 @@ int cmd_generate(const Args& args) {
   } catch (const InputError& e) {  // the system design's checks name system.* keys
     throw InputError(locate_in_config(config, e.what()));
   }
-  add_ip_package(files, design, p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl"),
+  add_ip_package(files, design, rtl_dir_option(p),
                  std::string(build_info::kSourceDir) + "/hls", build_info::kVersion, "--rtl",
                  !p.has("--no-sources"));
   if (!overrides.empty()) files["config.yaml"] = receiver_config_yaml(cfg);  // re-run: --config DIR/config.yaml

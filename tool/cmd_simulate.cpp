@@ -230,29 +230,23 @@ std::string stages_text(const SceneSimulator& sim) {
 }
 
 int cmd_simulate(const Args& args) {
-  cli::Parser p("ranging simulate",
-                "Run a scene (docs/scenes.md): build exactly the channel stages it names, send its\n"
-                "codes over its distances and decode them. Writes DIR/measurements.csv (one row per\n"
-                "measurement), DIR/summary.json and the effective scene (DIR/scene.yaml, and its\n"
-                "receiver configuration DIR/config.yaml: `ranging simulate DIR/scene.yaml` repeats the\n"
-                "run); prints the stages built and a summary.");
-  p.positional("SCENE", "scene file (YAML)");
+  cli::Parser p = command_parser("simulate");
   p.option("--precision", "float|fixed|rtl",
            "receiver precision (overrides the scene's receiver.precision); rtl: the fixed model, and every\n"
            "stream also through the Verilated receiver (built at run time), whose events must be identical");
   p.flag("--check-rtl", "the same as --precision rtl");
-  p.option("--rtl", "DIR", "with --precision rtl: the RTL sources (default: the project's rtl/)");
+  add_rtl_option(p, "with --precision rtl");
   p.option("--rtl-simulator", "verilator|postsynth|icarus|hls|systemc",
            "with --precision rtl: what runs the streams: verilator (the RTL), postsynth (the iCE40\n"
            "gate-level netlist of yosys synth_ice40 -dsp, Verilated with yosys' cell models) or icarus\n"
            "(the RTL in Icarus Verilog: slow, for cross-checking the simulator) or hls (the HLS C++,\n"
            "C simulation: events only) or systemc (the RTL Verilated as an SC_MODULE, driven under the\n"
            "SystemC kernel)", "verilator");
-  p.option("--out", "DIR", "output directory (created); default out/<scene name>");
-  p.flag("--json", "print the summary JSON on stdout instead of the text summary");
+  add_output_options(p, {.out = true, .out_default = "out/<scene name>", .json = true,
+                         .json_note = "the summary JSON on stdout instead of the text summary", .quiet = true});
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
   p.option("--plot", "FILE.png", "draw the distance error against the true distance, per family");
-  p.option("--jobs", "N", "streams (distances, repeats, codes) simulated in parallel, 1..256 (the output does not depend on it; --precision rtl runs one)", "1");
+  add_jobs_option(p, "streams (distances, repeats, codes) simulated", "; --precision rtl runs one");
   add_scene_options(p);
   if (!p.parse(args)) return 0;
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
@@ -287,7 +281,7 @@ int cmd_simulate(const Args& args) {
   if (scene.geometry.type == "rotor" && p.has("--write-captures")) {
     throw InputError("option --write-captures: not available for rotor scenes");
   }
-  const int jobs = static_cast<int>(p.integer("--jobs", 1, 1, 256));
+  const int jobs = jobs_option(p);
   OutputDir out_dir(out, "option --out");  // checked before any work; removed again if the run fails
   SceneSimulator sim(scene);
   sim.set_jobs(jobs);

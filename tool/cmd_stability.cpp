@@ -25,6 +25,7 @@
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
 #include "tool/guard.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -79,20 +80,17 @@ Worst worst_limit_cycle(const SosFilter& f, const BandpassFixedConfig& c) {
 }  // namespace
 
 int cmd_stability(const Args& args) {
-  cli::Parser p("ranging stability",
-                "Numerical stability report of a receiver configuration: the guard's verdict on the\n"
-                "quantized filter (exact pole radii, edge attenuations), overflow headroom per filter\n"
-                "and correlator-bank node under its worst-case input, zero-input limit cycles per rounding and overflow\n"
-                "mode, and the SOS vs direct-form comparison per filter type. An out-of-spec design\n"
-                "is reported, not refused.");
-  p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md); default: the built-in default");
-  p.option("--set", "KEY=VALUE", "override a key of the configuration, a dotted YAML path (repeatable): bandpass_fixed.coef_bits=10 (of --config, else of the built-in default)");
-  p.flag("--json", "machine-readable output");
+  cli::Parser p = command_parser("stability");
+  add_config_options(p, {.allow_out_of_spec = false});
+  add_output_options(p, {.json = true});
   p.flag("--quick", "skip the width sweeps and the structure comparison");
   if (!p.parse(args)) return 0;
+  // The built-in default with the overrides is read (and its guard checked) even with --config:
+  // the report studies an out-of-spec --config file, while --set that puts the default out of
+  // spec is refused.
   const Overrides overrides = parse_overrides(p.values("--set"));
   ReceiverConfig cfg = default_receiver_config(overrides);
-  if (auto f = p.get("--config"); f && p.has("--config")) cfg = load_receiver_config(*f, overrides, true);
+  if (p.has("--config")) cfg = load_receiver_config(*p.get("--config"), overrides, true);
   cfg.allow_out_of_spec = true;  // the report shows an out-of-spec design rather than refusing it
   BandpassSpec spec = cfg.filter;
   spec.fs = cfg.fs;

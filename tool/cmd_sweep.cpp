@@ -23,6 +23,7 @@
 #include "model/study/sweep.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
 namespace {
@@ -145,15 +146,10 @@ int cmd_merge(const Args& args) {
 
 int cmd_sweep(const Args& args) {
   if (!args.empty() && args[0] == "merge") return cmd_merge(Args(args.begin() + 1, args.end()));
-  cli::Parser p("ranging sweep",
-                "Design-space sweep (docs/design-space.md): run the spec's scene in the fixed model at every\n"
-                "point of its axes; write DIR/points.csv, DIR/sweep.json, DIR/summary.md and DIR/front.png\n"
-                "(Pareto fronts on cost vs distance RMSE and vs decode errors; the default marked).\n"
-                "Re-running with the same DIR keeps the points already done (DIR/points/ID.json).\n"
-                "`ranging sweep merge --out DIR SHARD_DIR...` merges --shard runs (see its --help).");
+  cli::Parser p = command_parser("sweep");
   p.positional("SPEC", "sweep spec (YAML): name, config, scene, mode, axes");
-  p.option("--out", "DIR", "output folder (created)");
-  p.option("--jobs", "N", "points evaluated in parallel, 1..256 (the output does not depend on it)", "1");
+  add_output_options(p, {.out = true, .quiet = true});
+  add_jobs_option(p, "points evaluated");
   p.option("--shard", "I/N", "evaluate only the points of shard I of N (a stable hash of their parameters)");
   p.option("--cache", "DIR", "synthesis cache folder, may be shared by shards (default: DIR/cache)");
   p.flag("--dry-run", "check the spec, print the ids and parameters of the points (of the shard) and exit; writes nothing");
@@ -161,10 +157,9 @@ int cmd_sweep(const Args& args) {
   p.option("--synth-targets", "LIST", "comma-separated yosys targets per point: ice40 (synth_ice40 -dsp), ecp5 "
            "(synth_ecp5), xilinx (synth_xilinx -family xc7); the fronts use ice40's LUT4 when it is in the list", "ice40");
   p.flag("--no-plot", "skip DIR/front.png (no Python needed)");
-  p.flag("--quiet", "no progress on stderr");
   if (!p.parse(args)) return 0;
   const std::string out = p.required("--out");
-  const int jobs = static_cast<int>(p.integer("--jobs", 1, 1, 256));
+  const int jobs = jobs_option(p);
   int shard_i = 0, shard_n = 1;
   if (p.has("--shard")) {
     const std::string s = *p.get("--shard");

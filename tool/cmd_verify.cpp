@@ -17,9 +17,10 @@
 #include "model/hw/hw_params.hpp"
 #include "model/hw/realtime.hpp"
 #include "model/sim/channel.hpp"
-#include "tool/build_info.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/json_meta.hpp"
+#include "tool/options.hpp"
 #include "tool/rtl_runner.hpp"
 
 namespace ranging::tool {
@@ -256,26 +257,17 @@ std::vector<RtlStimulus> stimuli(const ReceiverDesign& d, bool soak) {
 }  // namespace
 
 int cmd_verify(const Args& args) {
-  cli::Parser p("ranging verify",
-                "Verify the RTL of a receiver configuration against the golden model, bit for bit and\n"
-                "stage by stage (filter, bank framing, chip filter, combiner, weighted power, energy,\n"
-                "events). Generates the IP folder into a work folder, builds the Verilated receiver_top\n"
-                "there (verilator --build, cached), and runs coded streams of every code of the family\n"
-                "at several distances, the full-scale worst case, random input, random valid gaps with\n"
-                "back-pressure and a reset mid-stream. Exit status 0: every stage matched; 1: a mismatch\n"
-                "(the first is reported: stage, sample, expected, got); 2: bad input.");
-  p.option("--config", "FILE", "receiver configuration (YAML, docs/configuration.md)");
-  p.option("--rtl", "DIR", "take the RTL sources from DIR instead of the project's rtl/");
+  cli::Parser p = command_parser("verify");
+  add_config_options(p, {.required = true, .overrides = false, .allow_out_of_spec = false});
+  add_rtl_option(p);
   p.option("--out", "DIR", "work folder (IP folder, Verilator build, stimulus; default: under $TMPDIR)");
   p.flag("--soak", "the long run: ten distances, with and without noise, 10x longer noise streams");
   p.flag("--trace", "compile FST tracing in and write OUT/verify_<run>.fst (open with OUT/ip/receiver.gtkw)");
-  p.flag("--json", "machine-readable report on stdout");
-  p.flag("--quiet", "no progress on stderr");
+  add_output_options(p, {.json = true, .quiet = true});
   if (!p.parse(args)) return 0;
-  if (!p.positionals().empty()) throw InputError("unexpected argument '" + p.positionals().front() + "'");
   const std::string config = p.required("--config");
   const bool quiet = p.has("--quiet");
-  const ReceiverConfig cfg = load_receiver_config(config);
+  const ReceiverConfig cfg = load_config_options(p, "verify");
   check_generatable(cfg);
   const ReceiverDesign design = design_receiver(cfg);
 
@@ -373,11 +365,10 @@ int cmd_verify(const Args& args) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (p.has("--json")) {
     nlohmann::json j;
-    j["version"] = build_info::kVersion;
-    j["git_commit"] = build_info::kGitCommit;
+    stamp_build_info(j);
     j["config"] = cfg.name;
     j["config_file"] = config;
-    j["rtl"] = p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl");
+    j["rtl"] = rtl_dir_option(p);
     j["work_dir"] = rtl.work_dir().string();
     j["stages"] = nlohmann::json::array();
     for (int i = 0; i < kStageCount; ++i) {
@@ -402,7 +393,7 @@ int cmd_verify(const Args& args) {
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "verify " << cfg.name << " (" << config << "), RTL from "
-              << p.get_or("--rtl", std::string(build_info::kSourceDir) + "/rtl") << "\n";
+              << rtl_dir_option(p) << "\n";
     for (int i = 0; i < kStageCount; ++i) {
       std::cout << "  " << kStages[i] << std::string(16 - std::string(kStages[i]).size(), ' ')
                 << cmp.stage[i].compared << " compared, " << cmp.stage[i].mismatches << " mismatches\n";

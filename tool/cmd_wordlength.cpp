@@ -14,20 +14,15 @@
 #include "model/study/wordlength.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
+#include "tool/options.hpp"
 
 namespace ranging::tool {
 
 int cmd_wordlength(const Args& args) {
-  cli::Parser p("ranging wordlength",
-                "Word-length optimization (docs/design-space.md): the smallest width of each node of the\n"
-                "fixed-point receiver (greedy, node by node, then checked jointly) such that the spec's\n"
-                "scene in the fixed model keeps distance RMSE <= rmse_factor x the base's and at most\n"
-                "decode_errors errors. Writes DIR/config.yaml (the result), DIR/wordlength.json and\n"
-                "DIR/wordlength.md (accuracy and cost beside the base's).");
+  cli::Parser p = command_parser("wordlength");
   p.positional("SPEC", "spec (YAML): name, config, scene, tolerance {rmse_factor, decode_errors}, nodes [keys]");
-  p.option("--out", "DIR", "output folder (created)");
+  add_output_options(p, {.out = true, .quiet = true});
   p.flag("--synth", "also synthesize the base and the result (yosys synth_ice40; DIR/cache)");
-  p.flag("--quiet", "no progress on stderr");
   if (!p.parse(args)) return 0;
   const std::string out = p.required("--out");
   const study::WordLengthSpec spec = study::load_wordlength_spec(p.positionals().at(0));

@@ -1,8 +1,13 @@
 #pragma once
 // The subcommands of `ranging`. Each lives in tool/cmd_<name>.cpp, takes the arguments
 // after its name and returns the process exit status (InputError propagates: status 2).
+// What `ranging help` and `ranging NAME --help` say of them is kept in one table
+// (tool/commands.cpp): the name, the one-line summary and the description.
+#include <span>
 #include <string>
 #include <vector>
+
+#include "tool/cli.hpp"
 
 namespace ranging::tool {
 
@@ -22,5 +27,20 @@ int cmd_stability(const Args& args); // numerical stability report (cmd_stabilit
 int cmd_frames(const Args& args);    // decode the board's UART frames (cmd_frames.cpp)
 int cmd_verify(const Args& args);    // the RTL of a configuration against the model (cmd_verify.cpp)
 int cmd_bitstream(const Args& args); // iCEBreaker bitstream of a configuration, --program (cmd_bitstream.cpp)
+
+struct Command {
+  const char* name;
+  int (*run)(const Args&);
+  const char* summary;            // its line in `ranging help`
+  const char* description;        // `ranging NAME --help`, below the usage line
+  const char* synopsis = nullptr;  // the usage line after "ranging " (null: NAME)
+};
+
+// Every subcommand, in the order `ranging help` lists them.
+std::span<const Command> commands();
+
+// The parser of subcommand `name` (one of commands()): its usage line and description, and
+// --help; the command adds its options.
+cli::Parser command_parser(const std::string& name);
 
 }  // namespace ranging::tool

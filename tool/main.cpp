@@ -12,44 +12,11 @@
 
 namespace {
 
-struct Subcommand {
-  const char* name;
-  const char* summary;
-  int (*run)(const ranging::tool::Args&);
-};
-
-constexpr Subcommand kSubcommands[] = {
-    {"demo", "encode every code of a family, send it through a channel, decode it (float and fixed)",
-     ranging::tool::cmd_demo},
-    {"codes", "list code families, print their codes (M-sequences, Gold codes)",
-     ranging::tool::cmd_codes},
-    {"filter", "design the bandpass filter; print sections and quantized coefficients",
-     ranging::tool::cmd_filter},
-    {"generate", "generate the HLS C++ and Verilog of a receiver configuration",
-     ranging::tool::cmd_generate},
-    {"simulate", "run a scene: channel, receiver, per-measurement CSV and summary JSON",
-     ranging::tool::cmd_simulate},
-    {"evaluate", "reproduce the paper's Section 4 evaluation (Tables 4-6, Figures 13-15)",
-     ranging::tool::cmd_evaluate},
-    {"decode", "decode a recorded capture (oscilloscope CSV or WAV)", ranging::tool::cmd_decode},
-    {"doppler", "decode rate and ToF bias against a constant line-of-sight speed", ranging::tool::cmd_doppler},
-    {"sweep", "design-space sweep: accuracy and cost over axes, Pareto fronts (docs/design-space.md)", ranging::tool::cmd_sweep},
-    {"wordlength", "smallest fixed-point widths within an accuracy tolerance (docs/design-space.md)", ranging::tool::cmd_wordlength},
-    {"stability", "numerical stability report: guard, headroom, limit cycles, filter structures",
-     ranging::tool::cmd_stability},
-    {"frames", "decode the board's UART measurement frames (checksum, resync, bad-frame count)",
-     ranging::tool::cmd_frames},
-    {"verify", "verify the RTL of a configuration against the golden model, stage by stage",
-     ranging::tool::cmd_verify},
-    {"bitstream", "build the iCEBreaker bitstream of a configuration (open flow) and program the board",
-     ranging::tool::cmd_bitstream},
-};
-
 void print_usage(std::ostream& os) {
   os << "usage: ranging <command> [options]    (ranging help <command> for details; ranging --version)\n\n"
         "Coded ultrasonic ranging co-design toolkit (Lu et al., Micromachines 2025, 16, 240).\n\n"
         "commands:\n";
-  for (const Subcommand& c : kSubcommands) {
+  for (const ranging::tool::Command& c : ranging::tool::commands()) {
     os << "  " << c.name << std::string(10 - std::string(c.name).size(), ' ') << c.summary << "\n";
   }
 }
@@ -78,7 +45,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   ranging::install_output_cleanup_on_signals();  // Ctrl-C leaves no temporary output file
-  for (const Subcommand& c : kSubcommands) {
+  for (const ranging::tool::Command& c : ranging::tool::commands()) {
     if (args[0] == c.name) {
       try {
         const int status = c.run({args.begin() + 1, args.end()});
