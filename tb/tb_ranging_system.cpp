@@ -12,99 +12,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <deque>
 #include <iostream>
 #include <optional>
 #include <vector>
 
-// Verilator's headers are not -Wunused-parameter clean.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#include "Vranging_system.h"
-#include "tb/verilator_harness.hpp"
-#pragma GCC diagnostic pop
-#include "model/config/receiver_config.hpp"
+#include "tb/system_tb.hpp"  // Vranging_system, the harness, design(), sys(), UartDecoder
+#include "model/hw/frames.hpp"
 #include "model/sim/channel.hpp"
-#include "model/dsp/excitation.hpp"
-#include "model/hw/hw_system.hpp"
-#include "model/dsp/receiver.hpp"
 
 using namespace ranging;
+using namespace ranging::tb;
 
 namespace {
-
-const ReceiverDesign& design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
-const SystemDesign& sys() {
-  static const SystemDesign s = system_design(design());
-  return s;
-}
-
-// 8N1 receiver on the sampled line, div clocks per bit.
-class UartDecoder {
- public:
-  explicit UartDecoder(int div) : div_(div) {}
-  void sample(bool line) {
-    if (state_ < 0) {
-      if (prev_ && !line) {
-        state_ = 0;
-        count_ = div_ + div_ / 2;  // middle of data bit 0
-        byte_ = 0;
-      }
-    } else if (--count_ == 0) {
-      if (state_ < 8) {
-        byte_ |= static_cast<std::uint8_t>((line ? 1 : 0) << state_);
-        ++state_;
-        count_ = div_;
-      } else {
-        if (!line) ++framing_errors;
-        bytes.push_back(byte_);
-        state_ = -1;
-      }
-    }
-    prev_ = line;
-  }
-  std::deque<std::uint8_t> bytes;
-  int framing_errors = 0;
-
- private:
-  int div_, state_ = -1, count_ = 0;
-  bool prev_ = true;
-  std::uint8_t byte_ = 0;
-};
-
-struct Frame {
-  int code;
-  unsigned flags;
-  std::uint32_t tof, distance;
-  unsigned score, margin;
-};
-
-std::vector<Frame> parse_frames(std::deque<std::uint8_t> b, int* bad) {
-  std::vector<Frame> out;
-  auto u32 = [](const std::uint8_t* p) {
-    return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
-           static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
-  };
-  while (b.size() >= 17) {
-    if (b[0] != 0xA5 || b[1] != 0x5A) {
-      ++*bad;
-      b.pop_front();
-      continue;
-    }
-    std::uint8_t f[17];
-    for (int i = 0; i < 17; ++i) f[i] = b[static_cast<std::size_t>(i)];
-    std::uint8_t x = 0;
-    for (int i = 2; i < 16; ++i) x ^= f[i];
-    if (x != f[16]) ++*bad;
-    out.push_back(Frame{f[2], f[3], u32(f + 4), u32(f + 8), static_cast<unsigned>(f[12] | f[13] << 8),
-                        static_cast<unsigned>(f[14] | f[15] << 8)});
-    for (int i = 0; i < 17; ++i) b.pop_front();
-  }
-  return out;
-}
 
 TEST(RangingSystem, ClosedLoopSceneFramesMatchModel) {
   const auto& d = design();
@@ -132,10 +51,7 @@ TEST(RangingSystem, ClosedLoopSceneFramesMatchModel) {
 
   tb::Harness<Vranging_system> h("tb_ranging_system");
   auto& top = h.top();
-  top.adc_data = 0;
-  top.c_wr = 0;
-  top.c_value = 0;
-  h.reset(4);
+  reset_idle(h);
   UartDecoder uart(s.baud_div);
   std::size_t k_adc = 0;  // ADC conversions started (rising edges of adc_clk)
   std::size_t k_tick = 0;
@@ -155,7 +71,7 @@ TEST(RangingSystem, ClosedLoopSceneFramesMatchModel) {
       }
       ++k_tick;
     }
-    uart.sample(top.uart_tx != 0);
+    uart.sample(top.uart_tx != 0, h.cycles());
     h.tick();
     // An ideal ADC: converts on the rising edge of adc_clk, data out right after it.
     const bool ac = top.adc_clk != 0;
@@ -192,13 +108,14 @@ TEST(RangingSystem, ClosedLoopSceneFramesMatchModel) {
   EXPECT_EQ(drive_errors, 0u) << "H-bridge drive differs from hbridge_drive, first at sample " << first_drive_error;
   EXPECT_EQ(top.led_error, 0) << "ADC overrun: the receiver did not keep up at CLK_DIV " << clk_div;
   EXPECT_EQ(uart.framing_errors, 0);
-  int bad = 0;
-  const auto frames = parse_frames(uart.bytes, &bad);
-  EXPECT_EQ(bad, 0) << "bad sync or checksum";
+  FrameStats stats;
+  const auto frames = decode_uart_frames(uart.bytes, stats);
+  EXPECT_EQ(stats.bad_frames, 0u) << "bad sync or checksum";
+  EXPECT_EQ(stats.skipped_bytes, 0u) << "bytes outside frames";
   std::cout << frames.size() << " UART frames, " << expected.size() << " model measurements, "
             << k_tick << " samples at " << clk_div << " clocks per sample\n";
   for (const auto& f : frames) {
-    std::cout << "  code " << f.code << " tof " << f.tof / 256.0 << " samples distance " << f.distance
+    std::cout << "  code " << f.code << " tof " << f.tof_q8 / 256.0 << " samples distance " << f.distance_um
               << " um score " << f.score << " margin " << f.margin << "\n";
   }
   ASSERT_GE(frames.size(), settled);
@@ -210,15 +127,15 @@ TEST(RangingSystem, ClosedLoopSceneFramesMatchModel) {
     const auto& e = expected[i];
     EXPECT_EQ(f.code, e.code);
     EXPECT_EQ(f.flags, e.flags);
-    EXPECT_EQ(f.tof, e.tof);
-    EXPECT_EQ(f.distance, e.distance);
+    EXPECT_EQ(f.tof_q8, e.tof);
+    EXPECT_EQ(f.distance_um, e.distance);
     EXPECT_EQ(f.score, e.score);
     EXPECT_EQ(f.margin, e.margin);
     // The scene: burst i carried code i+1 and flew `distance`.
     EXPECT_EQ(f.code, static_cast<int>(i % static_cast<std::size_t>(eta)) + 1);
     EXPECT_EQ(f.flags, 0u);
-    EXPECT_NEAR(f.distance * 1e-6, distance, 0.002);
-    EXPECT_NEAR(f.tof / 256.0 * um_per_sample * 1e-6, f.distance * 1e-6, 1e-5);
+    EXPECT_NEAR(f.distance_um * 1e-6, distance, 0.002);
+    EXPECT_NEAR(f.tof_q8 / 256.0 * um_per_sample * 1e-6, f.distance_um * 1e-6, 1e-5);
   }
 }
 

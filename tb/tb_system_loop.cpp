@@ -29,18 +29,10 @@
 #include <random>
 #include <vector>
 
-// Verilator's headers are not -Wunused-parameter clean.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#include "Vranging_system.h"
-#include "tb/verilator_harness.hpp"
-#pragma GCC diagnostic pop
-#include "model/config/receiver_config.hpp"
+#include "tb/system_tb.hpp"  // Vranging_system, the harness, design(), sys(), UartDecoder
 #include "model/dsp/excitation.hpp"
-#include "model/dsp/receiver.hpp"
 #include "model/dsp/transducer.hpp"
 #include "model/hw/frames.hpp"
-#include "model/hw/hw_system.hpp"
 #include "model/hw/rotor_host.hpp"
 #include "model/hw/sound_speed_cal.hpp"
 #include "model/sim/moving_channel.hpp"
@@ -48,53 +40,9 @@
 #include "tests/process.hpp"
 
 using namespace ranging;
+using namespace ranging::tb;
 
 namespace {
-
-const ReceiverDesign& design() {
-  static const ReceiverDesign d = design_receiver(load_receiver_config(RANGING_CONFIG));
-  return d;
-}
-const SystemDesign& sys() {
-  static const SystemDesign s = system_design(design());
-  return s;
-}
-
-// 8N1 receiver on the sampled line, div clocks per bit; records the clock of each byte's stop bit.
-class UartDecoder {
- public:
-  explicit UartDecoder(int div) : div_(div) {}
-  void sample(bool line, std::uint64_t cycle) {
-    if (state_ < 0) {
-      if (prev_ && !line) {
-        state_ = 0;
-        count_ = div_ + div_ / 2;
-        byte_ = 0;
-      }
-    } else if (--count_ == 0) {
-      if (state_ < 8) {
-        byte_ |= static_cast<std::uint8_t>((line ? 1 : 0) << state_);
-        ++state_;
-        count_ = div_;
-      } else {
-        if (!line) ++framing_errors;
-        bytes.push_back(byte_);
-        cycles.push_back(cycle);
-        state_ = -1;
-      }
-    }
-    prev_ = line;
-  }
-  bool idle() const { return state_ < 0; }
-  std::vector<std::uint8_t> bytes;
-  std::vector<std::uint64_t> cycles;
-  int framing_errors = 0;
-
- private:
-  int div_, state_ = -1, count_ = 0;
-  bool prev_ = true;
-  std::uint8_t byte_ = 0;
-};
 
 // The ADC side of the loop: y[k] (full-scale units) of conversion k, from the drive so far.
 using AdcSource = std::function<double(std::size_t k, const std::vector<std::int8_t>& drive)>;
@@ -120,10 +68,7 @@ LoopRun run_loop(std::size_t n, const AdcSource& source, std::uint64_t cal_arm_c
   const auto t0 = std::chrono::steady_clock::now();
   tb::Harness<Vranging_system> h("tb_system_loop");
   auto& top = h.top();
-  top.adc_data = 0;
-  top.c_wr = 0;
-  top.c_value = 0;
-  h.reset(4);
+  reset_idle(h);
   UartDecoder uart(s.baud_div);
   LoopRun r;
   OverflowCounter clip;

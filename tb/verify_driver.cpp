@@ -61,96 +61,47 @@ void reset(Dut& d) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: verify_driver STIMULUS OUTPUT\n");
-    return 2;
-  }
-  std::FILE* in = std::fopen(argv[1], "r");
-  std::FILE* out = std::fopen(argv[2], "w");
-  if (!in || !out) {
-    std::fprintf(stderr, "verify_driver: cannot open %s or %s\n", argv[1], argv[2]);
-    return 2;
-  }
-  ranging::tb::DriverRun run;
-  int got = 0;
-  while ((got = ranging::tb::read_run(in, run)) > 0) {
-    const char* name = run.name.c_str();
-    const double valid_prob = run.valid_prob, ready_prob = run.ready_prob;
-    const unsigned long long seed = run.seed, quiet = run.quiet, cadence = run.cadence;
-    long long reset_at = run.reset_at;
-    const std::vector<std::uint64_t>& x = run.x;
-    std::fprintf(out, "run %s\n", name);
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    Dut d(std::string("verify_") + name);
-    reset(d);
-    std::size_t next = 0;
-    std::uint64_t cycles = 0, idle = 0, silent = 0, late = 0, due = 0;
-    bool stalled = false;
-    while (next < x.size() || silent < quiet) {
-      if (reset_at >= 0 && next == static_cast<std::size_t>(reset_at)) {
-        reset(d);
-        std::fprintf(out, "R\n");
-        reset_at = -1;
-      }
-      const bool offer = next < x.size() && (cadence ? cycles >= due : u(rng) < valid_prob);
-      d.top().s_axis_tvalid = offer;
-      if (offer) d.top().s_axis_tdata = static_cast<std::remove_reference_t<decltype(d.top().s_axis_tdata)>>(x[next]);
-      d.top().m_axis_tready = u(rng) < ready_prob;
-      d.settle();
-      bool beat = false;
-      if (offer && d.top().s_axis_tready) {
-        ++next;
-        idle = 0;
-        if (cadence) {
-          if (cycles > due) ++late;
-          due += cadence;
-        }
-      }
-      auto& t = d.top();
-      if (t.dbg_filter_valid) {
-        std::fputc('F', out);
-        hex(out, t.dbg_filter_data);
-        hex(out, t.dbg_filter_sections);
-        std::fputc('\n', out);
-        beat = true;
-      }
-      if (t.dbg_bank_valid) {
-        std::fputc('B', out);
-        hex(out, t.dbg_code);
-        hex(out, t.dbg_last);
-        hex(out, t.dbg_weighted);
-        hex(out, t.dbg_energy);
-        hex(out, t.dbg_index);
-        hex(out, t.dbg_chip_re);
-        hex(out, t.dbg_chip_im);
-        hex(out, t.dbg_corr_re);
-        hex(out, t.dbg_corr_im);
-        std::fputc('\n', out);
-        beat = true;
-      }
-      if (t.m_axis_tvalid && t.m_axis_tready) {
-        std::fputc('E', out);
-        hex(out, t.m_axis_tdata);
-        std::fputc('\n', out);
-        beat = true;
-      }
-      d.tick();
-      ++cycles;
-      silent = (beat || next < x.size()) ? 0 : silent + 1;
-      if (next < x.size() && ++idle > 200000) {
-        stalled = true;
-        break;
-      }
-    }
-    if (stalled) std::fprintf(out, "S %zu\n", next);
-    std::fprintf(out, "end %zu %" PRIu64 " %" PRIu64 "\n", next, cycles, late);
-  }
-  std::fclose(out);
-  std::fclose(in);
-  if (got < 0) {
-    std::fprintf(stderr, "verify_driver: run %s: short sample list\n", run.name.c_str());
-    return 2;
-  }
-  return 0;
+  return ranging::tb::driver_main(argc, argv, "verify_driver", [](const ranging::tb::DriverRun& run, std::FILE* out) {
+    Dut d(std::string("verify_") + run.name);
+    auto& t = d.top();
+    ranging::tb::drive_stream(
+        run, out, [&] { reset(d); },
+        [&](bool offer, std::uint64_t data, bool ready, bool* taken) {
+          t.s_axis_tvalid = offer;
+          if (offer) t.s_axis_tdata = static_cast<std::remove_reference_t<decltype(t.s_axis_tdata)>>(data);
+          t.m_axis_tready = ready;
+          d.settle();
+          *taken = t.s_axis_tready;
+          bool beat = false;
+          if (t.dbg_filter_valid) {
+            std::fputc('F', out);
+            hex(out, t.dbg_filter_data);
+            hex(out, t.dbg_filter_sections);
+            std::fputc('\n', out);
+            beat = true;
+          }
+          if (t.dbg_bank_valid) {
+            std::fputc('B', out);
+            hex(out, t.dbg_code);
+            hex(out, t.dbg_last);
+            hex(out, t.dbg_weighted);
+            hex(out, t.dbg_energy);
+            hex(out, t.dbg_index);
+            hex(out, t.dbg_chip_re);
+            hex(out, t.dbg_chip_im);
+            hex(out, t.dbg_corr_re);
+            hex(out, t.dbg_corr_im);
+            std::fputc('\n', out);
+            beat = true;
+          }
+          if (t.m_axis_tvalid && t.m_axis_tready) {
+            std::fputc('E', out);
+            hex(out, t.m_axis_tdata);
+            std::fputc('\n', out);
+            beat = true;
+          }
+          d.tick();
+          return beat;
+        });
+  });
 }

@@ -45,16 +45,6 @@ using value_t = typename std::remove_reference_t<Port>::data_type;
 }  // namespace
 
 int sc_main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: verify_driver_sc STIMULUS OUTPUT\n");
-    return 2;
-  }
-  std::FILE* in = std::fopen(argv[1], "r");
-  std::FILE* out = std::fopen(argv[2], "w");
-  if (!in || !out) {
-    std::fprintf(stderr, "verify_driver_sc: cannot open %s or %s\n", argv[1], argv[2]);
-    return 2;
-  }
   sc_core::sc_report_handler::set_actions(sc_core::SC_INFO, sc_core::SC_DO_NOTHING);
   Vreceiver_top top("top");
 #define RANGING_SIG(port) sc_core::sc_signal<value_t<decltype(top.port)>> port{#port}; top.port(port)
@@ -97,41 +87,14 @@ int sc_main(int argc, char** argv) {
     rst.write(false);
     sc_core::sc_start(1, SC_NS);
   };
-  ranging::tb::DriverRun run;
-  int got = 0;
-  while ((got = ranging::tb::read_run(in, run)) > 0) {
-    const char* name = run.name.c_str();
-    const double valid_prob = run.valid_prob, ready_prob = run.ready_prob;
-    const unsigned long long seed = run.seed, quiet = run.quiet, cadence = run.cadence;
-    long long reset_at = run.reset_at;
-    const std::vector<std::uint64_t>& x = run.x;
-    std::fprintf(out, "run %s\n", name);
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    reset();
-    std::size_t next = 0;
-    std::uint64_t cycles = 0, idle = 0, silent = 0, late = 0, due = 0;
-    bool stalled = false;
-    while (next < x.size() || silent < quiet) {
-      if (reset_at >= 0 && next == static_cast<std::size_t>(reset_at)) {
-        reset();
-        std::fprintf(out, "R\n");
-        reset_at = -1;
-      }
-      const bool offer = next < x.size() && (cadence ? cycles >= due : u(rng) < valid_prob);
+  return ranging::tb::driver_main(argc, argv, "verify_driver_sc", [&](const ranging::tb::DriverRun& run, std::FILE* out) {
+    ranging::tb::drive_stream(run, out, reset, [&](bool offer, std::uint64_t data, bool ready, bool* taken) {
       s_axis_tvalid.write(offer);
-      if (offer) s_axis_tdata.write(static_cast<value_t<decltype(top.s_axis_tdata)>>(x[next]));
-      m_axis_tready.write(u(rng) < ready_prob);
+      if (offer) s_axis_tdata.write(static_cast<value_t<decltype(top.s_axis_tdata)>>(data));
+      m_axis_tready.write(ready);
       sc_core::sc_start(1, SC_NS);  // settle the combinational outputs (clock low)
+      *taken = s_axis_tready.read();
       bool beat = false;
-      if (offer && s_axis_tready.read()) {
-        ++next;
-        idle = 0;
-        if (cadence) {
-          if (cycles > due) ++late;
-          due += cadence;
-        }
-      }
       if (dbg_filter_valid.read()) {
         std::fputc('F', out);
         hex(out, dbg_filter_data.read());
@@ -162,21 +125,7 @@ int sc_main(int argc, char** argv) {
       half(true);   // rising edge
       clk.write(false);
       sc_core::sc_start(4, SC_NS);
-      ++cycles;
-      silent = (beat || next < x.size()) ? 0 : silent + 1;
-      if (next < x.size() && ++idle > 200000) {
-        stalled = true;
-        break;
-      }
-    }
-    if (stalled) std::fprintf(out, "S %zu\n", next);
-    std::fprintf(out, "end %zu %" PRIu64 " %" PRIu64 "\n", next, cycles, late);
-  }
-  std::fclose(out);
-  std::fclose(in);
-  if (got < 0) {
-    std::fprintf(stderr, "verify_driver_sc: run %s: short sample list\n", run.name.c_str());
-    return 2;
-  }
-  return 0;
+      return beat;
+    });
+  });
 }
