@@ -21,7 +21,7 @@ ranging=""
 margin=1.10
 
 usage() {
-  cat <<EOF
+  cat <<'EOF'
 Usage: scripts/build_bitstream.sh [options]
 
 Builds the ranging system (rtl/ranging_system.v + the generated receiver) for the iCEBreaker
