@@ -5,6 +5,7 @@
 // (open with: gtkwave build/tb_receiver_top_<test>.fst build/generated/default/receiver.gtkw).
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <deque>
 #include <iostream>
@@ -280,3 +281,27 @@ TEST(ReceiverTop, RandomGapsBackPressureAndResetMidStream) {
     EXPECT_TRUE(b.run(x, x.size() / 3));  // reset in the middle: afterwards a fresh model
   }
 }
+
+#ifndef RANGING_TB_LARGE
+// Label soak (tb/CMakeLists.txt: discovered apart from the others; RANGING_SOAK=1
+// scripts/run-tests.sh): 10^8 samples (RANGING_SOAK_SAMPLES overrides) of the coded schedule at
+// 0.5 m with noise, chunk after chunk in one stream without a reset, with random valid gaps and
+// back-pressure, compared stage by stage with the model: every filter, bank and event beat.
+TEST(ReceiverTopSoak, HundredMillionSamplesStageByStage) {
+  const char* env = std::getenv("RANGING_SOAK_SAMPLES");
+  const std::uint64_t want = env ? std::strtoull(env, nullptr, 10) : 100000000ULL;
+  const auto x = coded_stream(0.5, 0.002, 5, 1400);
+  Bench b("soak", 0.95, 0.9, 23);
+  std::uint64_t fed = 0, chunks = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  while (fed < want) {
+    ASSERT_TRUE(b.run(x)) << "chunk " << chunks << " (sample " << fed << ")";
+    fed += x.size();
+    ++chunks;
+  }
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_GE(b.events_seen(), chunks * static_cast<std::uint64_t>(design().family.eta()));
+  std::cout << fed << " samples in " << chunks << " chunks, " << b.events_seen() << " events, 0 mismatches, " << s
+            << " s (" << fed / s << " samples/s)\n";
+}
+#endif
