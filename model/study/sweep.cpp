@@ -92,6 +92,16 @@ json SweepSpec::json() const {
   return j;
 }
 
+std::string spec_file(yaml::Reader& top, const std::string& spec_path, const fs::path& base, const std::string& key) {
+  std::string v;
+  if (!top.get(key, v)) throw InputError(spec_path + ": " + key + ": missing (a file, relative to the spec)");
+  fs::path p(v);
+  if (p.is_relative()) p = base / p;
+  p = p.lexically_normal();
+  if (!fs::exists(p)) top.error(key, "'" + p.string() + "' does not exist");
+  return p.string();
+}
+
 SweepSpec load_sweep_spec(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the sweep spec");
@@ -102,18 +112,9 @@ SweepSpec load_sweep_spec(const std::string& path) {
   s.origin = path;
   yaml::Reader top(root, path, "");
   const fs::path base = fs::absolute(fs::path(path)).parent_path();
-  auto resolve = [&](const std::string& k, std::string& out) {
-    std::string v;
-    if (!top.get(k, v)) throw InputError(path + ": " + k + ": missing (a file, relative to the spec)");
-    fs::path p(v);
-    if (p.is_relative()) p = base / p;
-    p = p.lexically_normal();
-    if (!fs::exists(p)) top.error(k, "'" + p.string() + "' does not exist");
-    out = p.string();
-  };
   top.get("name", s.name);
-  resolve("config", s.config_path);
-  resolve("scene", s.scene_path);
+  s.config_path = spec_file(top, path, base, "config");
+  s.scene_path = spec_file(top, path, base, "scene");
   top.get("mode", s.mode);
   yaml::one_of(top, "mode", s.mode, {"grid", "one-at-a-time", "random"});
   const bool has_points = top.get_range("points", s.points, 1, 100000);

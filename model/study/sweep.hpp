@@ -13,10 +13,15 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
+
+namespace ranging::yaml {
+class Reader;
+}  // namespace ranging::yaml
 
 namespace ranging::study {
 
@@ -41,6 +46,11 @@ struct SweepSpec {
 // Strict: unknown keys, a value the configuration (or scene) refuses, an empty axis, duplicate
 // axes and a bad mode are InputErrors naming "file:line: key".
 SweepSpec load_sweep_spec(const std::string& path);
+
+// A spec's file key (config, scene): the path it names, relative to the folder `base` of the
+// spec file `spec_path`, normalized. InputError when the key is missing or the file does not exist.
+std::string spec_file(yaml::Reader& top, const std::string& spec_path, const std::filesystem::path& base,
+                      const std::string& key);
 
 using Params = std::vector<std::pair<std::string, std::string>>;  // axis order
 

@@ -36,18 +36,9 @@ WordLengthSpec load_wordlength_spec(const std::string& path) {
   w.base.mode = "one-at-a-time";
   yaml::Reader top(root, path, "");
   const fs::path dir = fs::absolute(fs::path(path)).parent_path();
-  auto resolve = [&](const std::string& k, std::string& out) {
-    std::string v;
-    if (!top.get(k, v)) throw InputError(path + ": " + k + ": missing (a file, relative to the spec)");
-    fs::path p(v);
-    if (p.is_relative()) p = dir / p;
-    p = p.lexically_normal();
-    if (!fs::exists(p)) top.error(k, "'" + p.string() + "' does not exist");
-    out = p.string();
-  };
   top.get("name", w.base.name);
-  resolve("config", w.base.config_path);
-  resolve("scene", w.base.scene_path);
+  w.base.config_path = spec_file(top, path, dir, "config");
+  w.base.scene_path = spec_file(top, path, dir, "scene");
   yaml::section(top, "tolerance", [&](yaml::Reader& r) {
     r.get_range("rmse_factor", w.rmse_factor, 1.0, 100.0);
     r.get_range("decode_errors", w.decode_errors, 0, 1000000);
