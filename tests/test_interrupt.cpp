@@ -1,6 +1,7 @@
-// Interruption (issue 18, section 5): SIGINT or SIGTERM during `ranging simulate` or
-// `ranging sweep` leaves the previous outputs intact and no partial or temporary file, and
-// a re-run succeeds. The tool dies of the signal (its handler unlinks the temporaries of
+// Interruption (issue 18, section 5): SIGINT or SIGTERM during `ranging simulate`, `ranging
+// sweep`, `ranging evaluate` or `ranging bitstream` leaves the previous outputs intact and no
+// partial or temporary file, stops the external commands the tool started (yosys, nextpnr:
+// model/base/subprocess.hpp), and a re-run succeeds. The tool dies of the signal (its handler unlinks the temporaries of
 // model/base/atomic_file.hpp and re-raises), so the exit is "killed by SIGINT/SIGTERM".
 #include <gtest/gtest.h>
 
@@ -84,11 +85,12 @@ int run_and_signal_when(const std::vector<std::string>& args, int sig, const std
     ::_exit(127);
   }
   const auto t0 = std::chrono::steady_clock::now();
+  int status = 0;
   while (!ready() && std::chrono::steady_clock::now() - t0 < limit) {
+    if (::waitpid(pid, &status, WNOHANG) == pid) return status;  // ended on its own
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ::kill(pid, sig);
-  int status = 0;
   ::waitpid(pid, &status, 0);
   return status;
 }
@@ -169,6 +171,78 @@ TEST(InterruptSweep, SigtermLeavesWholePointFilesAndResumes) {
   const auto doc = nlohmann::json::parse(slurp(fs::path(out) / "sweep.json"));
   ASSERT_TRUE(doc.contains("points"));
   EXPECT_EQ(doc["points"].size(), 5u);  // 4 values of the axis and the base point
+  fs::remove_all(dir);
+}
+
+// The paper's evaluation, interrupted: the outputs of the run before are untouched.
+TEST(InterruptEvaluate, SigtermLeavesThePreviousResults) {
+  const fs::path dir = fs::temp_directory_path() / ("ranging_int_eval_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string paper = slurp(fs::path(RANGING_SOURCE_DIR) / "scenes/paper-section4.yaml");
+  ASSERT_FALSE(paper.empty());
+  auto with = [&](const std::vector<std::pair<std::string, std::string>>& lines) {
+    std::string s = paper;
+    for (const auto& [key, line] : lines) {
+      const auto at = s.find(key);
+      EXPECT_NE(at, std::string::npos) << key;
+      if (at != std::string::npos) s.replace(at, s.find('\n', at) - at, line);
+    }
+    return s;
+  };
+  // The same scene name: the long run would write the very files the short one wrote.
+  std::ofstream(dir / "short.yaml") << with({{"name: ", "name: ev"}, {"  family: [", "  family: [M1, Gold4]"},
+                                             {"  distances_m: [", "  distances_m: [0.1]"}, {"  repeats: ", "  repeats: 1"}});
+  std::ofstream(dir / "long.yaml") << with({{"name: ", "name: ev"}});
+  const std::string out = (dir / "out").string();
+  const auto first = ranging::testing_support::run_tool("evaluate " + (dir / "short.yaml").string() +
+                                                        " --no-plots --quiet --out " + out);
+  ASSERT_EQ(first.status, 0) << first.err;
+  const auto before = files_in(out);
+  ASSERT_EQ(before.count("ev-summary.json"), 1u);
+  const int status = run_and_signal({"evaluate", (dir / "long.yaml").string(), "--no-plots", "--quiet", "--out", out},
+                                    SIGTERM, std::chrono::milliseconds(1500));
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the evaluation ended before the signal: make long.yaml longer";
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  EXPECT_EQ(files_in(out), before) << "the interrupted evaluation changed or added files";
+  const auto again = ranging::testing_support::run_tool("evaluate " + (dir / "short.yaml").string() +
+                                                        " --no-plots --quiet --out " + out);
+  EXPECT_EQ(again.status, 0) << again.err;
+  EXPECT_EQ(files_in(out).size(), before.size());
+  fs::remove_all(dir);
+}
+
+// The FPGA flow interrupted during synthesis: the tool dies of the signal, yosys (started by
+// scripts/build_bitstream.sh, two processes down) stops with it, and no summary is left.
+TEST(InterruptBitstream, SigtermStopsTheFlowsCommands) {
+  if (std::system("command -v yosys >/dev/null") != 0) GTEST_FAIL() << "yosys not installed";
+  const fs::path dir = fs::temp_directory_path() / ("ranging_int_bitstream_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const std::string out = (dir / "out").string();
+  const fs::path log = fs::path(out) / "yosys_ice40.log";
+  const int status = run_and_signal_when(
+      {"bitstream", "--config", std::string(RANGING_SOURCE_DIR) + "/configs/default.yaml", "--out", out}, SIGTERM,
+      [&] { return fs::exists(log); }, std::chrono::milliseconds(60000));
+  ASSERT_TRUE(fs::exists(log)) << "the flow did not reach synthesis";
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the flow ended before the signal";
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  // Nothing that names the work folder is left running (yosys -l OUT/..., the script).
+  std::string left;
+  for (int i = 0; i < 50; ++i) {
+    left.clear();
+    for (const auto& e : fs::directory_iterator("/proc")) {
+      const std::string pid = e.path().filename().string();
+      if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+      std::string cmdline = slurp(e.path() / "cmdline"), stat = slurp(e.path() / "stat");
+      const auto close = stat.rfind(')');
+      if (close != std::string::npos && close + 2 < stat.size() && stat[close + 2] == 'Z') continue;
+      if (cmdline.find(out) != std::string::npos) left += pid + " ";
+    }
+    if (left.empty()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_EQ(left, "") << "processes of the interrupted flow still run";
+  EXPECT_FALSE(fs::exists(fs::path(out) / "results" / "bitstream.json")) << "a summary of an interrupted flow";
   fs::remove_all(dir);
 }
 

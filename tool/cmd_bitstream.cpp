@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "model/base/subprocess.hpp"
 #include "model/base/error.hpp"
 #include "model/config/receiver_config.hpp"
 #include "model/hw/hw_params.hpp"
@@ -179,7 +180,7 @@ int cmd_bitstream(const Args& args) {
   if (!p.has("--estimates")) cmd += " --no-others";
   if (p.has("--check")) cmd += " --check";
   cmd += " 1>&2";  // progress and the script's summary on stderr; ours on stdout
-  const int rc = exit_status(std::system(cmd.c_str()));
+  const int rc = exit_status(run_shell(cmd));
   if (rc == 2 || rc < 0 || !fs::exists(results / "bitstream.json")) {
     throw InputError("the flow failed (scripts/build_bitstream.sh exit status " + std::to_string(rc) +
                      "; its message is above, logs in " + out.string() + ")");

@@ -14,6 +14,7 @@
 #include <map>
 #include <sstream>
 
+#include "model/base/subprocess.hpp"
 #include "model/base/atomic_file.hpp"
 #include "model/sim/capture.hpp"
 #include "model/base/error.hpp"
@@ -258,7 +259,7 @@ std::vector<std::string> draw_figures(const Scene& scene, const std::string& ste
   std::string script = std::string(build_info::kSourceDir) + "/scripts/plot_section4.py";
   if (!fs::exists(script)) script = "scripts/plot_section4.py";
   const std::string cmd = "/usr/bin/python3 '" + script + "' '" + stem + "' '" + fig13_family + "' > /dev/null";
-  if (std::system(cmd.c_str()) != 0) {
+  if (run_shell(cmd) != 0) {
     throw InputError("figures: '" + cmd + "' failed (matplotlib missing? use --no-plots)");
   }
   for (const char* k : {"fig13", "fig14", "fig15", "fig11"}) figures.push_back(scene.name + "-" + k + ".png");

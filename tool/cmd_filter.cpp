@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "model/base/subprocess.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/filter_design.hpp"
 #include "model/dsp/quantize.hpp"
@@ -93,7 +94,7 @@ void plot_response(const std::string& png, const SosFilter& filter, const SosFil
   std::string script = (fs::path(__FILE__).parent_path().parent_path() / "scripts/plot_filter_response.py").string();
   if (!fs::exists(script)) script = "scripts/plot_filter_response.py";
   const std::string cmd = "/usr/bin/python3 '" + script + "' '" + data + "' '" + tmp + "' > /dev/null";
-  const int rc = std::system(cmd.c_str());
+  const int rc = run_shell(cmd);
   std::error_code ec;
   fs::remove(data, ec);
   if (rc != 0) {

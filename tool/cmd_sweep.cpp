@@ -18,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "model/base/subprocess.hpp"
 #include "model/base/error.hpp"
 #include "model/sim/capture.hpp"
 #include "model/study/sweep.hpp"
@@ -52,7 +53,7 @@ std::string source_dir() {
 void plot(const std::string& dir) {
   const std::string script = source_dir() + "/scripts/plot_sweep.py";
   const std::string cmd = "/usr/bin/python3 '" + script + "' '" + dir + "/sweep.json' '" + dir + "/front.png' > /dev/null";
-  if (std::system(cmd.c_str()) != 0) throw InputError("plot: '" + cmd + "' failed (matplotlib missing? use --no-plot)");
+  if (run_shell(cmd) != 0) throw InputError("plot: '" + cmd + "' failed (matplotlib missing? use --no-plot)");
 }
 
 // Points of the spec in canonical order, results from `results` by id.

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "model/base/subprocess.hpp"
 #include "model/base/error.hpp"
 #include "tool/build_info.hpp"
 #include "tool/shell.hpp"
@@ -35,7 +36,7 @@ void plot_with_script(const std::string& option, const std::string& script, cons
   }
   const std::string path = std::string(build_info::kSourceDir) + "/" + script;
   const std::string cmd = "/usr/bin/python3 " + shell_quote(path) + " " + shell_quote(data_path) + " " + shell_quote(tmp) + " > /dev/null";
-  const int rc = std::system(cmd.c_str());
+  const int rc = run_shell(cmd);
   std::error_code ec;
   fs::remove(data_path, ec);
   if (rc != 0) {

@@ -17,6 +17,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "model/base/subprocess.hpp"
 #include "model/base/error.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
@@ -38,7 +39,7 @@ std::string read(const fs::path& p) {
 }
 
 int shell(const std::string& cmd) {
-  const int st = std::system(cmd.c_str());
+  const int st = run_shell(cmd);
   return (st != -1 && WIFEXITED(st)) ? WEXITSTATUS(st) : -1;
 }
 

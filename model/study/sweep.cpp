@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "model/base/error.hpp"
+#include "model/base/subprocess.hpp"
 #include "model/config/overrides.hpp"
 #include "model/config/receiver_config.hpp"
 #include "model/config/yaml_reader.hpp"
@@ -326,7 +327,7 @@ json synthesize(const std::map<std::string, std::string>& files, const PointOpti
   cmd += "read_verilog -defer -I. receiver_top.v; hierarchy -top receiver_top; " + std::string(target.script) +
          "; tee -q -o stat.txt stat' > /dev/null 2>&1";
   const auto t0 = std::chrono::steady_clock::now();
-  if (std::system(cmd.c_str()) != 0) {
+  if (run_shell(cmd) != 0) {
     return json{{"synth_error", std::string("yosys (") + target.name + ") failed: see " + work + "/yosys.log"}};
   }
   json j{{"rtl_hash", hash}};
