@@ -430,5 +430,14 @@ TEST(StabilityCli, ReportStudiesAnOutOfSpecConfigurationInsteadOfRefusingIt) {
   EXPECT_NE(r.out.find("UNSTABLE"), std::string::npos);
 }
 
+// The same design made by --set on the built-in default and on a --config file: reported too.
+TEST(StabilityCli, ReportStudiesAnOutOfSpecOverrideInsteadOfRefusingIt) {
+  for (const std::string& base : {std::string(), " --config " + std::string(RANGING_SOURCE_DIR) + "/configs/default.yaml"}) {
+    const auto r = run_tool("stability --quick" + base + " --set bandpass_fixed.coef_bits=6 --set bandpass_fixed.coef_frac=4");
+    ASSERT_EQ(r.status, 0) << base << ": " << r.err;
+    EXPECT_NE(r.out.find("guard: FAILS: bandpass_fixed.coef_bits: 6"), std::string::npos) << r.out;
+  }
+}
+
 }  // namespace
 }  // namespace ranging
