@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <iostream>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -54,6 +56,40 @@ class TofBench {
     h_.tick();
     t.c_wr = 0;
     model_.set_speed(c);
+  }
+  // One event through the module, the RTL's measurement only (no model): nullopt if the module
+  // did not take it or answer within `limit` clocks.
+  std::optional<Measurement32> measure(int code, std::int64_t arrival, std::uint64_t limit) {
+    auto& t = h_.top();
+    const int arr_w = sys().time_w + sys().frac_w + 1;
+    t.s_code = static_cast<std::uint8_t>(code);
+    ranging::tb::set_port(t.s_arrival, arrival, arr_w);
+    t.s_score = 1;
+    t.s_margin = 1;
+    t.s_valid = 1;
+    t.m_ready = 1;
+    std::uint64_t clocks = 0;
+    for (;;) {
+      h_.settle();
+      const bool take = t.s_ready;
+      h_.tick();
+      if (take) break;
+      if (++clocks > limit) return std::nullopt;
+    }
+    t.s_valid = 0;
+    for (;;) {
+      h_.settle();
+      if (t.m_valid) break;
+      h_.tick();
+      if (++clocks > limit) return std::nullopt;
+    }
+    Measurement32 m;
+    m.code = t.m_code;
+    m.flags = t.m_flags;
+    m.tof = t.m_tof;
+    m.distance = t.m_distance;
+    h_.tick();  // m_ready high: taken
+    return m;
   }
   // One event through the module; returns false with a message on a mismatch.
   ::testing::AssertionResult event(int code, std::int64_t arrival, std::uint32_t score, std::uint32_t margin,
@@ -161,6 +197,56 @@ TEST(TofDistanceRtl, DirectedCornersAndRandomEventsEqualTheModel) {
   EXPECT_TRUE(b.flags_seen() & 1u);
   EXPECT_TRUE(b.flags_seen() & 2u);
   EXPECT_TRUE(b.flags_seen() & 4u);
+}
+
+// The sample counters (tx_scheduler's burst time, the bank's index) are TIME_W bits and wrap
+// after 2^TIME_W samples (61 h at 5 MS/s with 40 bits). Across the wrap the bursts' times and the
+// arrivals both restart near 0 (mod 2^TIME_W), while the model's int64 time does not wrap. This
+// test drives the module as the wrapped counters would across it, a burst every PERIOD_T and
+// its echo `flight` samples later, and requires every measurement to be either the true time
+// of flight or flagged (no burst, saturated), never a wrong value with no flag, and every
+// answer to come within a bounded number of clocks (the event stream must not stall).
+// DISABLED (a known fault, issue 18; run it with --gtest_also_run_disabled_tests): the echo of the
+// last burst before the wrap arrives after it, with a small arrival index while the last burst
+// time is near 2^TIME_W; the module then steps its burst time back one CYCLE per two clocks,
+// about 7.5e7 steps for the default configuration, 1.5e8 clocks (5 s at 30 MHz), before it
+// flags the event "no burst". Every other measurement across the wrap is right (71 of 72 with a
+// limit of 2e8 clocks), but the 5-second stall backs the receiver up into an ADC overrun.
+TEST(TofDistanceRtl, DISABLED_AcrossTheSampleCounterWrapEveryMeasurementIsRightOrFlagged) {
+  const SystemDesign& s = sys();
+  const std::int64_t one = std::int64_t{1} << s.frac_w, T = s.period_t;
+  const std::int64_t wrap = std::int64_t{1} << s.time_w;
+  auto off = [&](int code) { return s.offsets[static_cast<std::size_t>(code - 1)]; };
+  TofBench b;
+  const std::int64_t flight = 800;  // samples: 54 mm at 340 m/s
+  int code = 1, right = 0, flagged = 0, wrong = 0, stalled = 0;
+  std::int64_t t = wrap - 4 * s.codes * T;  // true (unwrapped) time of the next burst
+  for (int i = 0; i < 8 * s.codes; ++i, t += T) {
+    b.burst(code, t % wrap);
+    const std::int64_t echo = t + flight;
+    // The bank's index wraps: the arrival, receiver latency included, modulo 2^TIME_W samples.
+    const auto m = b.measure(code, (echo * one + off(code)) % (wrap * one), 20000);
+    if (!m) {
+      ++stalled;
+      std::cout << "burst " << i << " (time " << t << "): no answer within 20000 clocks\n";
+      break;
+    }
+    if (m->flags != 0) {
+      ++flagged;
+    } else if (m->tof == static_cast<std::uint32_t>(flight * one)) {
+      ++right;
+    } else {
+      ++wrong;
+      std::cout << "burst " << i << " (time " << t << ", wrapped " << (t % wrap) << "): ToF " << m->tof / double(one)
+                << " samples, flags 0, true " << flight << "\n";
+    }
+    code = code == s.codes ? 1 : code + 1;
+  }
+  std::cout << right << " right, " << flagged << " flagged, " << wrong << " wrong unflagged, " << stalled
+            << " stalled across the wrap at 2^" << s.time_w << "\n";
+  EXPECT_EQ(wrong, 0);
+  EXPECT_EQ(stalled, 0);
+  EXPECT_GT(right, 0);
 }
 
 }  // namespace
