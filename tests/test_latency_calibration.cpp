@@ -56,3 +56,15 @@ TEST(LatencyCalibration, MissingOrWrongCodeNamesTheCode) {
     EXPECT_EQ(std::string(e.what()), "calibration: code 2");
   }
 }
+
+TEST(LatencyCalibration, AnyCodeTakesTheStrongestWhateverItsCode) {
+  // The demo's mode: a misdecoding receiver is calibrated on what it reports.
+  const auto off = calibrate_receiver_latency<Event>(
+      2, 10.0, [](int) { return std::vector<Event>{{1, 30.0, 0.2, 0}, {2, 40.0, 0.8, 0}}; },
+      [](int code) { return "code " + std::to_string(code); }, CalibrationCode::Any);
+  EXPECT_EQ(off, (std::vector<double>{30.0, 30.0}));
+  EXPECT_THROW((void)calibrate_receiver_latency<Event>(
+                   1, 0.0, [](int) { return std::vector<Event>{}; }, [](int) { return std::string("none"); },
+                   CalibrationCode::Any),
+               InputError);
+}
