@@ -19,6 +19,11 @@
 //                    CODES PERIOD_T while A - t_j 2^FRAC_W < 0 (the schedule is
 //                    strictly periodic, so no per-code table is needed); t_j < 0
 //                    means the code was never sent (flag)
+//              A  += 2^(TIME_W+FRAC_W)    while A - t_j 2^FRAC_W < -2^(TIME_W+FRAC_W-1):
+//                                         the sample counters wrap after 2^TIME_W
+//                                         samples, and an arrival more than half
+//                                         that range behind the burst was counted
+//                                         after the wrap (tb_tof_distance crosses it)
 //              ToF = A - t_j 2^FRAC_W     unsigned TOF_W, FRAC_W fraction bits
 //                                         (full-rate samples), saturated
 //              distance = (ToF * C + 2^(FRAC_W+C_FRAC-1)) >> (FRAC_W+C_FRAC)
@@ -34,7 +39,8 @@
 // Timing:    sequential (no DSP): the offset is subtracted over two clocks (low
 //            half at capture, high half in the first step-back cycle), up to
 //            CODES-1 cycles to step back to code j's burst, 2-3 cycles for the
-//            ToF (its subtractor is registered; two more per cycle stepped back),
+//            ToF (its subtractor is registered; two more per cycle stepped back
+//            and across a counter wrap),
 //            TOF_W cycles of shift-add (one C_W+1-bit adder) multiply with the
 //            rounding term as its start value, 1 cycle to saturate the distance,
 //            then the result waits on m_ready. s_ready is high only when idle:
@@ -148,6 +154,11 @@ module tof_distance #(
   // subtractor and the saturation test into mplier are in different clocks
   reg signed [DW-1:0] tof_w;
   always @(posedge clk) tof_w <= a - ($signed(t) <<< FRAC_W);
+  // The sample counters wrap after 2^TIME_W samples: A - t 2^FRAC_W < -2^(TIME_W+FRAC_W-1), an
+  // arrival more than half the range behind the burst, was counted after the wrap; A is then
+  // 2^TIME_W samples later (a carry into A's top bits; AW leaves room for it).
+  localparam integer WK = TIME_W + FRAC_W - 1;
+  wire wrapped = tof_w[DW-1] && !(&tof_w[DW-1:WK]);
   wire [C_W:0] hsum = {1'b0, hi} + (mplier[0] ? {1'b0, c_used} : {(C_W+1){1'b0}});
 
   always @(posedge clk) begin
@@ -169,7 +180,7 @@ module tof_distance #(
         BACK: if (cnt == 0) state <= TOF0;
         TOF0: state <= TOF;
         TOF: state <= (no_tx || (!t[TW-1] && !tof_w[DW-1])) ? MUL
-                     : (t[TW-1] || t_step_neg) ? TOF : TOF0;  // stepped back: wait for tof_w
+                     : (t[TW-1] || (t_step_neg && !wrapped)) ? TOF : TOF0;  // stepped back or A moved: wait for tof_w
         MUL: if (cnt == TOF_W - 1) state <= CLAMP;
         CLAMP: state <= OUT;
         OUT: if (m_ready) state <= IDLE;
@@ -208,6 +219,8 @@ module tof_distance #(
           sat <= 1'b0;
         end else if (t[TW-1]) begin
           no_tx <= 1'b1;  // code j's burst would precede the first one: never sent
+        end else if (wrapped) begin
+          a[AW-1:WK+1] <= a[AW-1:WK+1] + 1'b1;  // A + 2^(TIME_W+FRAC_W)
         end else if (tof_w[DW-1]) begin
           if (t_step_neg) no_tx <= 1'b1;
           else t <= t_step;

@@ -196,8 +196,13 @@ Measurement32 TofDistanceModel::execute(int code, std::int64_t arrival, std::uin
   const std::int64_t cycle = static_cast<std::int64_t>(s_.codes) * s_.period_t;
   std::int64_t tof = 0;
   if (t < 0) no_tx = true;  // the code's burst would precede the first one: never sent
+  // The sample counters wrap after 2^time_w samples: an arrival more than half that range
+  // behind the burst was counted after the wrap, so it is 2^time_w samples later (rtl/tof_distance.v).
+  const std::int64_t range = std::int64_t{1} << (s_.time_w + s_.frac_w);
+  std::int64_t a_w = a;
+  while (!no_tx && a_w - t * (std::int64_t{1} << s_.frac_w) < -(range >> 1)) a_w += range;
   while (!no_tx) {
-    tof = a - t * (std::int64_t{1} << s_.frac_w);
+    tof = a_w - t * (std::int64_t{1} << s_.frac_w);
     if (tof >= 0) break;
     if (t < cycle) no_tx = true;
     else t -= cycle;
