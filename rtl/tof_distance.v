@@ -145,8 +145,11 @@ module tof_distance #(
   wire signed [KW:0] diff = $signed({2'b00, last_code}) - $signed({2'b00, s_code});
   wire signed [KW:0] k0 = diff < 0 ? diff + CODES : diff;
 
-  // one subtractor steps t back (a period in BACK, a cycle in TOF); its sign in TOF is t < CYCLE
-  wire signed [TW-1:0] t_step = t - (state == BACK ? PERIOD_T : CYCLE);
+  // one subtractor steps t back (a period in BACK, a cycle in TOF); its sign in TOF is t < CYCLE.
+  // in_back is state == BACK as a register of its own: the operand select then comes from one
+  // flip-flop, not from the state decode, ahead of the TW-bit carry chain (a critical path).
+  reg in_back;
+  wire signed [TW-1:0] t_step = t - (in_back ? PERIOD_T : CYCLE);
   // sign of t - CYCLE, registered: TOF reads it after TOF0, where t has not changed
   reg t_step_neg;
   always @(posedge clk) t_step_neg <= t_step[TW-1];
@@ -168,6 +171,7 @@ module tof_distance #(
       last_time <= 0;
       last_code <= 0;
       c_current <= C_INIT;
+      in_back <= 1'b0;
     end else begin
       if (burst_valid) begin
         have_burst <= 1'b1;
@@ -176,8 +180,14 @@ module tof_distance #(
       end
       if (c_wr) c_current <= c_value;
       case (state)
-        IDLE: if (s_valid) state <= BACK;
-        BACK: if (cnt == 0) state <= TOF0;
+        IDLE: if (s_valid) begin
+          state <= BACK;
+          in_back <= 1'b1;
+        end
+        BACK: if (cnt == 0) begin
+          state <= TOF0;
+          in_back <= 1'b0;
+        end
         TOF0: state <= TOF;
         TOF: state <= (no_tx || (!t[TW-1] && !tof_w[DW-1])) ? MUL
                      : (t[TW-1] || (t_step_neg && !wrapped)) ? TOF : TOF0;  // stepped back or A moved: wait for tof_w
