@@ -62,7 +62,12 @@ Outcome interrupt_child(bool use_run_shell, int sig) {
     if (::waitpid(child, &o.status, WNOHANG) == child) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  // The signalled sleep may need a moment to be scheduled and exit on a loaded machine: it
+  // survived if it still runs 3 s later.
+  const auto t1 = std::chrono::steady_clock::now();
+  while (sleeper > 0 && running(sleeper) && std::chrono::steady_clock::now() - t1 < std::chrono::seconds(3)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
   o.sleep_survived = sleeper > 0 && running(sleeper);
   if (sleeper > 0) ::kill(sleeper, SIGKILL);
   if (::waitpid(child, &o.status, WNOHANG) == 0) {  // still running (std::system with SIGINT)
