@@ -40,7 +40,8 @@ PY
 )
 
 step "2/4 RTL equivalence: tb_receiver_top (Verilator)"
-if "$build/tb/tb_receiver_top" > "$work/rtl.log" 2>&1; then rtl_ok=PASS; else rtl_ok=FAIL; fi
+# The equivalence tests; the 10^8-sample soak (ReceiverTopSoak, label soak) is left to ctest -L soak.
+if "$build/tb/tb_receiver_top" --gtest_filter='-*Soak.*' > "$work/rtl.log" 2>&1; then rtl_ok=PASS; else rtl_ok=FAIL; fi
 rtl_samples=$(awk '{for (i = 1; i + 2 <= NF; i++) if ($(i+1) == "samples" && $(i+2) == "compared") s += $i} END {print s + 0}' "$work/rtl.log")
 [[ $rtl_samples -gt 0 ]] || rtl_ok=FAIL  # a run that compared nothing proves nothing
 
