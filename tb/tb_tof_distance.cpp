@@ -57,43 +57,11 @@ class TofBench {
     t.c_wr = 0;
     model_.set_speed(c);
   }
-  // One event through the module, the RTL's measurement only (no model): nullopt if the module
-  // did not take it or answer within `limit` clocks.
-  std::optional<Measurement32> measure(int code, std::int64_t arrival, std::uint64_t limit) {
-    auto& t = h_.top();
-    const int arr_w = sys().time_w + sys().frac_w + 1;
-    t.s_code = static_cast<std::uint8_t>(code);
-    ranging::tb::set_port(t.s_arrival, arrival, arr_w);
-    t.s_score = 1;
-    t.s_margin = 1;
-    t.s_valid = 1;
-    t.m_ready = 1;
-    std::uint64_t clocks = 0;
-    for (;;) {
-      h_.settle();
-      const bool take = t.s_ready;
-      h_.tick();
-      if (take) break;
-      if (++clocks > limit) return std::nullopt;
-    }
-    t.s_valid = 0;
-    for (;;) {
-      h_.settle();
-      if (t.m_valid) break;
-      h_.tick();
-      if (++clocks > limit) return std::nullopt;
-    }
-    Measurement32 m;
-    m.code = t.m_code;
-    m.flags = t.m_flags;
-    m.tof = t.m_tof;
-    m.distance = t.m_distance;
-    h_.tick();  // m_ready high: taken
-    return m;
-  }
-  // One event through the module; returns false with a message on a mismatch.
-  ::testing::AssertionResult event(int code, std::int64_t arrival, std::uint32_t score, std::uint32_t margin,
-                                   int ready_delay) {
+  // One event through the module: offered until s_ready, then m_ready held low for ready_delay
+  // clocks after m_valid; the RTL's measurement, or nullopt if the module did not take the event
+  // or did not answer within `limit` clocks (each).
+  std::optional<Measurement32> measure(int code, std::int64_t arrival, std::uint32_t score, std::uint32_t margin,
+                                       int ready_delay, std::uint64_t limit) {
     auto& t = h_.top();
     const int arr_w = sys().time_w + sys().frac_w + 1;
     t.s_code = static_cast<std::uint8_t>(code);
@@ -102,31 +70,44 @@ class TofBench {
     t.s_margin = static_cast<std::uint16_t>(margin);
     t.s_valid = 1;
     t.m_ready = 0;
-    int guard = 0;
-    for (;;) {
+    for (std::uint64_t clocks = 0;; ++clocks) {
       h_.settle();
       const bool take = t.s_ready;
       h_.tick();
       if (take) break;
-      if (++guard > 100000) return ::testing::AssertionFailure() << "s_ready never rose";
+      if (clocks >= limit) return std::nullopt;
     }
     t.s_valid = 0;
-    guard = 0;
-    for (;;) {
+    for (std::uint64_t clocks = 0;; ++clocks) {
       h_.settle();
       if (t.m_valid) break;
       h_.tick();
-      if (++guard > 100000) return ::testing::AssertionFailure() << "no measurement";
+      if (clocks >= limit) return std::nullopt;
     }
     for (int i = 0; i < ready_delay; ++i) h_.tick();  // held while m_valid && !m_ready
     h_.settle();
-    const Measurement32 e = model_.execute(code, arrival, score, margin);
-    const int got_code = t.m_code, got_flags = t.m_flags;
-    const std::uint32_t got_tof = t.m_tof, got_dist = t.m_distance;
-    const std::uint32_t got_score = t.m_score, got_margin = t.m_margin;
+    Measurement32 m;
+    m.code = t.m_code;
+    m.flags = t.m_flags;
+    m.tof = t.m_tof;
+    m.distance = t.m_distance;
+    m.score = t.m_score;
+    m.margin = t.m_margin;
     t.m_ready = 1;
     h_.tick();
     t.m_ready = 0;
+    return m;
+  }
+  // One event through the module; returns false with a message on a mismatch.
+  ::testing::AssertionResult event(int code, std::int64_t arrival, std::uint32_t score, std::uint32_t margin,
+                                   int ready_delay) {
+    const auto got = measure(code, arrival, score, margin, ready_delay, 100000);
+    if (!got) return ::testing::AssertionFailure() << "the module did not take the event or answer";
+    const Measurement32 e = model_.execute(code, arrival, score, margin);
+    const int got_code = got->code, got_flags = static_cast<int>(got->flags);
+    const std::uint32_t got_tof = got->tof, got_dist = got->distance;
+    const std::uint32_t got_score = static_cast<std::uint32_t>(got->score);
+    const std::uint32_t got_margin = static_cast<std::uint32_t>(got->margin);
     ++events_;
     flags_seen_ |= 1u << got_flags;
     if (got_code != e.code || static_cast<unsigned>(got_flags) != e.flags || got_tof != e.tof ||
@@ -221,7 +202,7 @@ TEST(TofDistanceRtl, AcrossTheSampleCounterWrapEveryMeasurementIsRight) {
     model.burst(code, t % wrap);
     const std::int64_t flight = 700 + 37 * (i % 11);  // samples
     const std::int64_t arrival = ((t + flight) * one + off(code)) % (wrap * one);
-    const auto m = b.measure(code, arrival, 20000);
+    const auto m = b.measure(code, arrival, 1, 1, 0, 20000);
     ASSERT_TRUE(m) << "burst " << i << " (time " << t << "): no answer within 20000 clocks";
     const Measurement32 e = model.execute(code, arrival, 1, 1);
     EXPECT_EQ(m->flags, e.flags) << "burst " << i;

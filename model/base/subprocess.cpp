@@ -19,16 +19,19 @@ constexpr int kSlots = 64;  // commands running at once (sweep --jobs); more are
 std::atomic<pid_t> g_groups[kSlots];  // process groups of the running commands (0: free)
 std::atomic<int> g_received{0};       // the first signal received while any ran
 
+// sig to the process group, then SIGTERM: a non-interactive shell starts its background jobs
+// (cmd &) with SIGINT ignored. Async-signal-safe.
+void forward_to(pid_t group, int sig) {
+  ::kill(-group, sig);
+  if (sig != SIGTERM) ::kill(-group, SIGTERM);
+}
+
 extern "C" void forward_signal(int sig) {
   int none = 0;
   g_received.compare_exchange_strong(none, sig);
   for (auto& g : g_groups) {
     const pid_t p = g.load();
-    if (p <= 0) continue;
-    ::kill(-p, sig);
-    // A non-interactive shell starts its background jobs (cmd &) with SIGINT ignored: SIGTERM
-    // reaches them too.
-    if (sig != SIGTERM) ::kill(-p, SIGTERM);
+    if (p > 0) forward_to(p, sig);
   }
 }
 
@@ -90,10 +93,7 @@ int run_shell(const std::string& cmd) {
       if (g_groups[i].compare_exchange_strong(free, pid)) slot = i;
     }
     // A signal that came before the slot was published: forward it now.
-    if (const int sig = g_received.load()) {
-      ::kill(-pid, sig);
-      if (sig != SIGTERM) ::kill(-pid, SIGTERM);
-    }
+    if (const int sig = g_received.load()) forward_to(pid, sig);
   }
   ::pthread_sigmask(SIG_SETMASK, &prev, nullptr);
   if (pid > 0) {
