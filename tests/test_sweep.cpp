@@ -214,6 +214,20 @@ TEST_F(Sweep, BadSpecsExitTwoNamingFileLineAndKeyAndWriteNothing) {
   }
 }
 
+// A referenced file whose name the file system refuses (longer than NAME_MAX) is a bad input, not a crash
+// (found by fuzz_sweep_spec: std::filesystem::exists threw filesystem_error and the tool terminated).
+TEST_F(Sweep, ANameTooLongForTheFileSystemExitsTwoNamingTheKey) {
+  const fs::path s = dir_ / "long.yaml";
+  std::ofstream(s) << "name: tiny\nconfig: " << std::string(5000, 'c') << ".yaml\nscene: scene.yaml\n"
+                   << "mode: grid\naxes:\n  - key: correlator_fixed.chip_bits\n    values: [14]\n";
+  const auto r = run_tool("sweep " + s.string() + " --out " + (dir_ / "out").string() + " --no-synth --no-plot");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_NE(r.err.find(s.string() + ":2: config"), std::string::npos) << r.err.substr(0, 300);
+  EXPECT_NE(r.err.find("does not exist (File name too long)"), std::string::npos) << r.err.substr(0, 300);
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
 // The recipe of docs/design-space.md: GNU parallel runs the shards, `sweep merge` joins them.
 TEST_F(Sweep, GnuParallelShardsMergeToTheSerialRun) {
   const fs::path s = spec("grid", grid_axes());

@@ -99,7 +99,9 @@ std::string spec_file(yaml::Reader& top, const std::string& spec_path, const fs:
   fs::path p(v);
   if (p.is_relative()) p = base / p;
   p = p.lexically_normal();
-  if (!fs::exists(p)) top.error(key, "'" + p.string() + "' does not exist");
+  std::error_code ec;  // no throw: a name too long or unreadable is a bad input, not a crash
+  if (!fs::exists(p, ec) || ec)
+    top.error(key, "'" + p.string() + "' does not exist" + (ec ? " (" + ec.message() + ")" : std::string()));
   return p.string();
 }
 
