@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
-# The formal proofs can fail: a copy of the RTL with one handshake broken must make the proof of
-# measurement_uart fail. The mutant advances the frame's byte index on every clock instead of on
-# the transmitter's ready (`else if (byte_ready)` -> `else`), so the byte offered to uart_tx
-# changes while it waits: the AXI-Stream rule asserted of uart_tx's input fails (BMC finds it in
-# a few steps). Exit 0 when the mutant is caught, 1 when it slips through, 2 on a tool error.
+# The formal proofs can fail, with both engines: copies of the RTL with one handshake broken must
+# make the proofs fail.
+#  - smtbmc: the mutant measurement_uart advances the frame's byte index on every clock instead
+#    of on the transmitter's ready (`else if (byte_ready)` -> `else`), so the byte offered to
+#    uart_tx changes while it waits: the AXI-Stream rule asserted of uart_tx's input fails (BMC
+#    finds it in a few steps).
+#  - abc: the mutant peak_detector leaves S_OUT without m_ready (drops a waiting event): the
+#    output-stream assertion (m_valid held until m_ready) fails in BMC.
+# Exit 0 when both mutants are caught, 1 when one slips through, 2 on a tool error.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-case "${1:-}" in -h|--help) sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
+case "${1:-}" in -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
 work=$(mktemp -d "${TMPDIR:-/tmp}/ranging-mutant-XXXXXX")
 trap 'rm -rf "$work"' EXIT
 cp "$root"/rtl/*.v "$work/"
@@ -16,10 +20,27 @@ if cmp -s "$root/rtl/measurement_uart.v" "$work/measurement_uart.v"; then
 fi
 "$root/formal/run_formal.sh" measurement_uart --rtl "$work" --out "$work/out" --depth 20 --bmc-only
 rc=$?
+[[ $rc == 2 ]] && { echo "mutation_test: tool error" >&2; exit 2; }
 if [[ $rc == 1 ]] && grep -q "uart_tx.v" "$work/out/measurement_uart-bmc.log"; then
   echo "mutation_test: the broken handshake is caught ($(grep -o 'Assert failed in [^ ]* [^ ]*' "$work/out/measurement_uart-bmc.log" | head -1))"
+else
+  echo "mutation_test: the measurement_uart mutant was NOT caught (run_formal exit $rc)" >&2
+  exit 1
+fi
+# the abc engine: the detector's event is dropped while it waits for m_ready
+cp "$root/rtl/peak_detector.v" "$work/peak_detector.v"
+sed -i 's/S_OUT: if (m_ready) state <= S_IDLE;/S_OUT: state <= S_IDLE;/' "$work/peak_detector.v"
+if cmp -s "$root/rtl/peak_detector.v" "$work/peak_detector.v"; then
+  echo "mutation_test: the mutation did not apply (rtl/peak_detector.v changed?)" >&2; exit 2
+fi
+# the held-valid assertion's cell is named after the line of its enclosing `if`
+held=$(grep -n 'assert(m_valid);' "$work/peak_detector.v" | head -1 | cut -d: -f1)
+msg=$("$root/formal/run_formal.sh" peak_detector --rtl "$work" --out "$work/out-pd" --bmc-only)
+rc=$?
+[[ $rc == 2 ]] && { echo "mutation_test: tool error" >&2; exit 2; }
+if [[ $rc == 1 ]] && grep -q "peak_detector.v:$((held - 1))\\$" <<<"$msg"; then
+  echo "mutation_test: the dropped event is caught ($msg)"
   exit 0
 fi
-[[ $rc == 2 ]] && { echo "mutation_test: tool error" >&2; exit 2; }
-echo "mutation_test: the mutant was NOT caught (run_formal exit $rc)" >&2
+echo "mutation_test: the peak_detector mutant was NOT caught as expected (run_formal exit $rc: $msg)" >&2
 exit 1

@@ -1,16 +1,20 @@
 #!/usr/bin/env bash
 # Proves the formal properties of one RTL module (the `ifdef FORMAL` blocks beside the module in
-# rtl/*.v, ZipCPU style) with yosys-smtbmc and z3: bounded model checking to DEPTH steps from
-# reset, then k-induction of the same depth (unbounded proof) unless the module's job file says
-# the induction does not close. Exit 0: every assertion holds; 1: a property fails (the
-# counterexample trace goes to OUT/NAME-{bmc,ind}.vcd); 2: usage or tool error.
+# rtl/*.v, ZipCPU style): bounded model checking to DEPTH steps from reset, then an unbounded
+# proof unless the job file says it does not close. Engine smtbmc (default): yosys-smtbmc with
+# z3, the proof k-induction of the same depth. Engine abc: the model as AIGER, yosys-abc's
+# bmc3 (BMC) and pdr (property-directed reachability, the proof), as SymbiYosys' `abc bmc3` /
+# `abc pdr`. Exit 0: every assertion holds; 1: a property fails (smtbmc: the counterexample
+# trace goes to OUT/NAME-{bmc,ind}.vcd; abc: OUT/NAME-{bmc,pdr}.aiw and the failing assertion's
+# name); 2: usage or tool error.
 #
 # Usage: formal/run_formal.sh JOB [--rtl DIR] [--out DIR] [--depth N] [--bmc-only]
 #   JOB is formal/JOB.job: lines `top MODULE`, `files a.v b.v` (relative to the RTL folder),
-#   `chparam NAME VALUE` (parameters for the proof), `induction yes|no`, `depth N`.
+#   `chparam NAME VALUE` (parameters for the proof), `define NAME` (a Verilog define),
+#   `engine smtbmc|abc`, `induction yes|no` (the unbounded proof), `depth N`.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-usage() { sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
 [[ $# -ge 1 ]] || { usage >&2; exit 2; }
 case "$1" in -h|--help) usage; exit 0 ;; esac
 job=$1; shift
@@ -28,28 +32,68 @@ while [[ $# -gt 0 ]]; do
 done
 jf="$root/formal/$job.job"
 [[ -f "$jf" ]] || { echo "run_formal: no job file $jf" >&2; exit 2; }
-for t in yosys yosys-smtbmc z3; do
-  command -v "$t" >/dev/null || { echo "run_formal: $t not found (scripts/install-deps.sh installs it)" >&2; exit 2; }
-done
-top=""; files=(); chp=""; induction=yes; jdepth=24; defines=""
+top=""; files=(); chp=""; induction=yes; jdepth=24; defines=""; engine=smtbmc
 while read -r key rest; do
   case "$key" in
     ''|'#'*) ;;
     top) top=$rest ;;
     files) read -r -a files <<<"$rest" ;;
-    chparam) read -r n v <<<"$rest"; chp+="chparam -set $n $v $top; " ;;
+    chparam) read -r n v <<<"$rest"; chp+="-set $n $v " ;;
     define) defines+=" -D$rest" ;;
     induction) induction=$rest ;;
     depth) jdepth=$rest ;;
+    engine) engine=$rest
+            [[ $engine == smtbmc || $engine == abc ]] || { echo "run_formal: $jf: engine must be smtbmc or abc, got '$engine'" >&2; exit 2; } ;;
     *) echo "run_formal: $jf: unknown key '$key'" >&2; exit 2 ;;
   esac
 done <"$jf"
+# all parameters in one chparam (one elaboration with the proof's parameters)
+[[ -n $chp ]] && chp="chparam $chp $top; "
+if [[ $engine == smtbmc ]]; then tools=(yosys yosys-smtbmc z3); else tools=(yosys yosys-abc); fi
+for t in "${tools[@]}"; do
+  command -v "$t" >/dev/null || { echo "run_formal: $t not found (scripts/install-deps.sh installs it)" >&2; exit 2; }
+done
 depth=${depth:-$jdepth}
 out=${out:-"${TMPDIR:-/tmp}/ranging-formal-$job-$$"}
 mkdir -p "$out"
 uc=$(echo "$top" | tr a-z A-Z)
 rc=""
 for f in "${files[@]}"; do rc+="read_verilog -formal -DFORMAL -DF_$uc$defines $rtl/$f; "; done
+if [[ $engine == abc ]]; then
+  # one AIGER model (assertions as bad states, assumptions as constraints; uninitialized
+  # registers free at step 0), as SymbiYosys writes it for its abc engines
+  yosys -q -l "$out/$job-yosys.log" -p "$rc $chp prep -top $top; flatten; memory_map; opt -fast; async2sync; \
+      chformal -assume -early; setundef -undriven -anyseq; opt -fast; delete -output; dffunmap; techmap; \
+      opt -fast; dffunmap; abc -g AND -fast; opt_clean; dffunmap; aigmap; tee -q -o $out/$job-asserts.txt select -list t:\$assert; \
+      write_aiger -I -B -zinit -map $out/$job.aim $out/$job.aig" >/dev/null \
+    || { echo "run_formal: yosys failed, see $out/$job-yosys.log" >&2; exit 2; }
+  # bad-state outputs are numbered in the order of the model's assertion cells
+  name_of() { grep -F "/\$assert" "$out/$job-asserts.txt" | sed -n "$(( $1 + 1 ))p"; }
+  abc_run() {  # abc_run KIND COMMAND
+    yosys-abc -c "read_aiger $out/$job.aig; fold; strash; $2; write_cex -a $out/$job-$1.aiw" >"$out/$job-$1.log" 2>&1 \
+      || { echo "run_formal: yosys-abc failed, see $out/$job-$1.log" >&2; exit 2; }
+    local f
+    f=$(grep -o 'Output [0-9]* of miter "[^"]*" was asserted in frame [0-9]*' "$out/$job-$1.log" | head -1 || true)
+    if [[ -n $f ]]; then
+      local idx=${f#Output }; idx=${idx%% *}
+      echo "$job: $1 FAILED: $f: $(name_of "$idx") (witness $out/$job-$1.aiw)"
+      exit 1
+    fi
+  }
+  t0=$(date +%s)
+  abc_run bmc "bmc3 -F $depth"
+  grep -q "No output asserted in $depth frames" "$out/$job-bmc.log" \
+    || { echo "run_formal: bmc3 did not finish $depth frames, see $out/$job-bmc.log" >&2; exit 2; }
+  echo "$job: BMC depth $depth passed ($(( $(date +%s) - t0 )) s, abc bmc3)"
+  if [[ $induction == yes && $bmc_only == 0 ]]; then
+    t0=$(date +%s)
+    abc_run pdr "pdr"
+    grep -q "Property proved" "$out/$job-pdr.log" \
+      || { echo "run_formal: pdr gave no answer, see $out/$job-pdr.log" >&2; exit 2; }
+    echo "$job: pdr proof passed ($(( $(date +%s) - t0 )) s): proven for all depths"
+  fi
+  exit 0
+fi
 # one SMT2 model of the flattened design; async2sync/dffunmap as SymbiYosys' prep does
 yosys -q -l "$out/$job-yosys.log" -p "$rc $chp prep -top $top; flatten; opt_clean; async2sync; chformal -assume -early; dffunmap; \
     write_smt2 -wires $out/$job.smt2" >/dev/null || { echo "run_formal: yosys failed, see $out/$job-yosys.log" >&2; exit 2; }

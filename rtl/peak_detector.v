@@ -423,10 +423,20 @@ module peak_detector #(
   assign s_ready = (state == S_IDLE);
 
   // MAC pipeline (datapath, no reset needed: m_run / v1 / v2 are controlled below)
+`ifdef FORMAL_FREE_PRODUCT
+  // Formal abstraction (formal/peak_detector.job): the product is any value in every clock, so
+  // the control and output-bound properties are proven for every multiplier result (the
+  // product's value is the equivalence benches' job); it keeps the solver off a 16x16 multiply.
+  (* anyseq *) wire [31:0] f_prod;
+`endif
   always @(posedge clk) begin
     ma <= a_dig;
     mb <= b_dig;
+`ifdef FORMAL_FREE_PRODUCT
+    prod <= f_prod;
+`else
     prod <= ma * mb;
+`endif
   end
 
   // ---------------------------------------------------------------- control (reset)
@@ -639,6 +649,95 @@ module peak_detector #(
   assign m_arrival = dv_d[ARR_W-1:0];
   assign m_score   = sc1;
   assign m_margin  = sc1 - score_now;
+
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh peak_detector). Assumed: reset first; the input
+  // follows the AXI-Stream rules (valid held until ready, beat stable while waiting) and frames
+  // groups of at most CODES beats (s_last on beat CODES-1 at the latest); m_ready free.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && $past(s_valid && !s_ready)) begin
+      assume(s_valid);
+      assume(s_weighted == $past(s_weighted) && s_last == $past(s_last) &&
+             s_energy == $past(s_energy) && s_index == $past(s_index));
+    end
+  always @(*) if (s_valid && j == JLAST) assume(s_last);
+  // f_ev: an event's fraction has been set up (S_P2) since reset (fmag and dsel have no reset)
+  reg f_ev = 1'b0;
+  always @(posedge clk)
+    if (rst) f_ev <= 1'b0;
+    else if (state == S_P2) f_ev <= 1'b1;
+  // f_scan: a beat has been scanned since reset (best has no reset)
+  reg f_scan = 1'b0;
+  always @(posedge clk)
+    if (rst) f_scan <= 1'b0;
+    else if (h_v) f_scan <= 1'b1;
+  // f_dec: a group has been decided since reset (s_found, r_v, r_end are cleared there)
+  reg f_dec = 1'b0;
+  always @(posedge clk)
+    if (rst) f_dec <= 1'b0;
+    else if (state == S_DECIDE) f_dec <= 1'b1;
+  // f_cand: a candidate has been taken since reset (c_code, c_code1 have no reset)
+  reg f_cand = 1'b0;
+  always @(posedge clk)
+    if (rst) f_cand <= 1'b0;
+    else if (state == S_DECIDE && gate_r && (!c_valid || d_gt0)) f_cand <= 1'b1;
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [CODE_W+JB-1:0] f_cc1 = {{CODE_W{1'b0}}, c_code} + 1'b1;
+  /* verilator lint_on UNUSEDSIGNAL */
+  // Reset state: idle, ready for a beat, no event, no candidate, no MAC program.
+  always @(posedge clk)
+    if (f_past_valid && $past(rst))
+      assert(state == S_IDLE && s_ready && !m_valid && !c_valid && !c_has_next && j == 0 &&
+             !m_run && !m_done && !v1 && !v2 && !h_v);
+  // The state is one of the machine's; the beat counter and the code indices stay below CODES.
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(state == S_IDLE || state == S_MAC || state == S_DECIDE || state == S_P0 ||
+             state == S_P1 || state == S_DIV || state == S_NEXT || state == S_OUT ||
+             state == S_CP || state == S_EA || state == S_EB || state == S_P2 ||
+             state == S_R2 || state == S_PS);
+      assert(j <= JLAST);
+      if (h_v) assert(h_j <= JLAST);
+      if (f_scan) assert(best <= JLAST);
+      if (f_dec && s_found) assert(sidx <= JLAST);
+      if (f_cand) assert(c_code <= JLAST && c_code1 == f_cc1[CODE_W-1:0]);
+      if (c_valid || m_valid) assert(f_cand);
+      // a pending Q_next only for a candidate
+      if (c_has_next) assert(c_valid);
+      // one ready at a time: never an input beat while an event is presented
+      assert(!(s_ready && m_valid));
+    end
+  // Detector output bounds: the code is 1..CODES; the fraction is clamped to +-2^(FRAC_W-1), so
+  // the arrival is within DECIM 2^(FRAC_W-1) of n 2^FRAC_W (mod 2^ARR_W); the margin is a difference of two
+  // scores in SCORE_W bits (by construction).
+  localparam integer F_SPAN = DECIM * HALF_I;
+  // (the arrival is a time stamp: it wraps with the sample index, so the offset is taken mod
+  // 2^ARR_W)
+  wire signed [ARR_W-1:0] f_off = m_arrival - {1'b0, c_n, {FRAC_W{1'b0}}};
+  always @(*)
+    if (f_past_valid && !rst) begin
+      if (f_ev) assert(fmag <= HALF);
+      if (state == S_DIV || state == S_NEXT || state == S_OUT) assert(f_ev && dsel <= 2'd2);
+      if (state == S_OUT) assert(dsel == 2'd2);
+      if (m_valid) begin
+        assert(m_code >= 1 && m_code <= CODES);
+        assert(f_off >= -F_SPAN && f_off <= F_SPAN);
+      end
+      // the arrival's fraction term is current from the second score's division on
+      if (f_ev && dsel == 2'd2 && (state == S_DIV || state == S_NEXT || state == S_OUT))
+        assert(frac_d == times_decim(frac_x));
+    end
+  // AXI-Stream master: m_valid stays up until m_ready, and the event is stable while it waits.
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && !rst && $past(m_valid && !m_ready)) begin
+      assert(m_valid);
+      assert(m_code == $past(m_code) && m_arrival == $past(m_arrival) &&
+             m_score == $past(m_score) && m_margin == $past(m_margin));
+    end
+`endif
 endmodule
 
 `default_nettype wire
