@@ -117,6 +117,12 @@ module bandpass_sos #(
   output wire [SECTIONS*DATA_W-1:0] m_sections  // every section's output for this sample (debug tap)
 );
 
+`ifdef FORMAL_FREE_PRODUCT
+  // Formal abstraction (formal/bandpass_sos*.job): every product is any value in every clock,
+  // so the handshake properties are proven for every multiplier result (the values are the
+  // equivalence benches' job).
+  (* anyseq *) wire signed [COEF_W+((DATA_W > DATA_FRAC + 1) ? DATA_W : DATA_FRAC + 1)-1:0] f_prod;
+`endif
   // Multiplier data operand: section outputs (DATA_W) and the aligned input
   // (DATA_FRAC+1 bits: |x| <= 2^DATA_FRAC) both fit.
   localparam integer DW = (DATA_W > DATA_FRAC + 1) ? DATA_W : DATA_FRAC + 1;
@@ -448,7 +454,11 @@ module bandpass_sos #(
         if (run) begin
           mul_a <= cf;
           mul_b <= diff[DW1-1:1];
+`ifdef FORMAL_FREE_PRODUCT
+          prod <= f_prod;
+`else
           prod <= mul_a * mul_b;
+`endif
           acc <= acc_next;  // exact mod 2^AC: the final sum fits
         end
       end
@@ -598,7 +608,11 @@ module bandpass_sos #(
               if (active && step == STEP_A1) taps_hold <= taps_in;
               // Multiply.
               t2_v <= t1_v; t2_first <= t1_first; t2_neg <= t1_neg; t2_last <= t1_last;
-              prod <= mul_a * mul_b;
+    `ifdef FORMAL_FREE_PRODUCT
+          prod <= f_prod;
+`else
+          prod <= mul_a * mul_b;
+`endif
               // Accumulate (exact: the model proves every partial sum fits ACC_W).
               if (t2_v) acc <= acc_next[ACC_W-1:0];
               done <= t2_v && t2_last;
@@ -640,6 +654,41 @@ module bandpass_sos #(
     wire unused_last_link = &{1'b0, link_data[SECTIONS*DW +: DW]};
   end
   endgenerate
+
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh bandpass_sos, bandpass_sos_general). Assumed: reset
+  // first; the input follows the AXI-Stream rules (valid held until ready, data stable while
+  // waiting); m_ready free.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && $past(s_valid && !s_ready)) begin
+      assume(s_valid);
+      assume(s_data == $past(s_data));
+    end
+  // samples in flight: taken on s_*, not yet handed out on m_*
+  localparam integer F_MAXFLY = 2 * SECTIONS + 8;
+  reg [7:0] f_fly = 8'd0;
+  always @(posedge clk)
+    if (rst) f_fly <= 8'd0;
+    else f_fly <= f_fly + {7'd0, s_valid && s_ready} - {7'd0, m_valid && m_ready};
+  // Reset state: no output, ready for a sample.
+  always @(posedge clk)
+    if (f_past_valid && $past(rst)) assert(!m_valid && s_ready && f_fly == 0);
+  // No output without a sample taken for it (nothing duplicated), and a bounded pipeline.
+  always @(*)
+    if (f_past_valid && !rst) begin
+      if (m_valid) assert(f_fly != 8'd0);
+      assert(f_fly <= F_MAXFLY);
+    end
+  // AXI-Stream master: m_valid stays up until m_ready, the sample and the taps are stable.
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && !rst && $past(m_valid && !m_ready)) begin
+      assert(m_valid);
+      assert(m_data == $past(m_data) && m_sections == $past(m_sections));
+    end
+`endif
 
 endmodule
 
