@@ -730,6 +730,12 @@ module peak_detector #(
       if (f_ev && dsel == 2'd2 && (state == S_DIV || state == S_NEXT || state == S_OUT))
         assert(frac_d == times_decim(frac_x));
     end
+  // The MAC accumulator is exact: acc +- prod never leaves AW signed bits (the sum one bit wider
+  // equals its AW-bit value sign-extended).
+  wire signed [AW:0] f_sum = {acc[AW-1], acc} + ({prod_x[AW-1], prod_x} ^ {(AW+1){s2}}) +
+                             {{AW{1'b0}}, s2};
+  always @(*)
+    if (f_past_valid && !rst && v2) assert(f_sum[AW] == f_sum[AW-1]);
   // AXI-Stream master: m_valid stays up until m_ready, and the event is stable while it waits.
   always @(posedge clk)
     if (f_past_valid && !$past(rst) && !rst && $past(m_valid && !m_ready)) begin
