@@ -62,6 +62,30 @@ TEST(CliItems, EveryJsonOutputCarriesVersionAndCommit) {
   fs::remove_all(tmp);
 }
 
+TEST(CliItems, TheCommandListSeparatesEveryNameFromItsSummary) {
+  // `ranging --help`: each command line is "  NAME  summary", names in one column, at least two
+  // spaces after the longest (a fixed column once ran "wordlength" into its summary)
+  const auto r = run_tool("--help");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto at = r.out.find("commands:\n");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::istringstream lines(r.out.substr(at + 10));
+  static const std::regex row("^  ([a-z]+)( {2,})(\\S.*)$");
+  std::size_t column = 0, rows = 0;
+  bool saw_wordlength = false;
+  for (std::string line; std::getline(lines, line) && !line.empty();) {
+    std::smatch m;
+    ASSERT_TRUE(std::regex_match(line, m, row)) << "not NAME  summary: '" << line << "'";
+    const std::size_t col = 2 + m[1].length() + m[2].length();
+    if (column == 0) column = col;
+    EXPECT_EQ(col, column) << line;
+    saw_wordlength = saw_wordlength || m[1] == "wordlength";
+    ++rows;
+  }
+  EXPECT_GE(rows, 10u);
+  EXPECT_TRUE(saw_wordlength);
+}
+
 TEST(CliItems, HelpCmdIsCmdHelp) {
   for (const char* c : {"codes", "verify", "generate", "simulate"}) {
     const auto a = run_tool(std::string("help ") + c);

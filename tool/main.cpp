@@ -1,4 +1,5 @@
 // `ranging`: the command-line front end of the golden model.
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <iostream>
@@ -16,8 +17,10 @@ void print_usage(std::ostream& os) {
   os << "usage: ranging <command> [options]    (ranging help <command> for details; ranging --version)\n\n"
         "Coded ultrasonic ranging co-design toolkit (Lu et al., Micromachines 2025, 16, 240).\n\n"
         "commands:\n";
+  std::size_t width = 0;  // the longest name, then two spaces
+  for (const ranging::tool::Command& c : ranging::tool::commands()) width = std::max(width, std::string(c.name).size());
   for (const ranging::tool::Command& c : ranging::tool::commands()) {
-    os << "  " << c.name << std::string(10 - std::string(c.name).size(), ' ') << c.summary << "\n";
+    os << "  " << c.name << std::string(width + 2 - std::string(c.name).size(), ' ') << c.summary << "\n";
   }
 }
 
