@@ -519,7 +519,18 @@ module correlator_bank #(
   reg             s1_first, s2_first, s1_last, s2_last, s1_neg, s2_neg, s1_lane, s2_lane;
   reg [SH_W-1:0]  s1_sh, s2_sh;
   reg [JI_W-1:0]  s1_j, s2_j;
+`ifdef FORMAL_NARROW_PRODUCT
+  // Formal abstraction (formal/correlator_bank.job): the limb product of the low F_MA_W x F_MB_W
+  // operand bits only, the widest any client presents (its FORMAL block asserts the upper bits
+  // are zero for every product issued, so the products are the same): a 16x16 multiplier with
+  // free upper bits is too slow for the solver at the job's small widths.
+  localparam integer F_MA_W = (imax(imax(DEC_W, CORR_W), 2 * CORR_W) < LW) ? imax(imax(DEC_W, CORR_W), 2 * CORR_W) : LW;
+  localparam integer F_MB_W = (imax(imax(TAP_W, CORR_W), WEIGHT_W) < LW) ? imax(imax(TAP_W, CORR_W), WEIGHT_W) : LW;
+  wire [F_MA_W+F_MB_W-1:0] f_mp = ma[F_MA_W-1:0] * mb[F_MB_W-1:0];
+  always @(posedge clk) mp <= {{(2*LW-F_MA_W-F_MB_W){1'b0}}, f_mp};
+`else
   always @(posedge clk) mp <= ma * mb;
+`endif
   /* verilator lint_off UNUSEDSIGNAL */
   wire [XW-1:0] psh = {{(XW-2*LW){1'b0}}, mp} << {s2_sh, 4'b0000};
   /* verilator lint_on UNUSEDSIGNAL */
@@ -898,6 +909,193 @@ module correlator_bank #(
   assign m_chip_im  = rd_bank ? chip_im1 : chip_im0;
   assign m_corr_re  = c_rd[2*CORR_W-1:CORR_W];
   assign m_corr_im  = c_rd[CORR_W-1:0];
+
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh correlator_bank). Assumed: reset first; the input
+  // follows the AXI-Stream rules (valid held until ready, data stable while waiting); m_ready
+  // free. Proven: the reset state, the output stream rules, no overflow on the exact nodes
+  // (acc, E, the chip FIR accumulator, C, P, Q: each sum computed wider here must fit its
+  // register), index/counter bounds and the group/energy-ring bookkeeping.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && $past(s_valid && !s_ready)) begin
+      assume(s_valid);
+      assume(s_data == $past(s_data));
+    end
+
+  // Reset state: front end idle and ready, sums and rings empty, back end and output idle.
+  always @(posedge clk)
+    if (f_past_valid && $past(rst))
+      assert(fe_state == FE_IDLE && s_ready && !m_valid && acc_re == 0 && acc_im == 0 &&
+             energy == 0 && phase == 0 && b_ptr == 0 && !b_full && !y_full && y_ptr == Y_LAST &&
+             dphase == 0 && bd_wptr == BD_LAST && bd_cnt == 0 && !bd_pend && eq_n == 0 &&
+             eq_w == 0 && eq_r == 0 && !s1_v && !s2_v && !a_busy && !a_prime && !fq_pend &&
+             !fres_valid && c_state == C_IDLE && !c_iss1 && f_cnt == 0 && ca_re == 0 &&
+             ca_im == 0 && !cq_valid && !pw_valid && !q_we && !b_busy && g_full == 0 &&
+             rd_j == 0 && m_index == DECIM_T - 1'b1);
+
+  // AXI-Stream master: m_valid stays up until m_ready, every m_* output is stable meanwhile.
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && $past(m_valid && !m_ready)) begin
+      assert(m_valid);
+      assert(m_weighted == $past(m_weighted) && m_code == $past(m_code) &&
+             m_last == $past(m_last) && m_energy == $past(m_energy) &&
+             m_index == $past(m_index) && m_chip_re == $past(m_chip_re) &&
+             m_chip_im == $past(m_chip_im) && m_corr_re == $past(m_corr_re) &&
+             m_corr_im == $past(m_corr_im));
+    end
+
+  // Groups in flight, each holding one energy-ring entry from its hand-off until its last beat
+  // is taken: pending Bd, FIR running or its last product / quantization in flight, F waiting,
+  // back end busy, finished groups.
+  wire f_a_tail1 = s1_v && s1_cl == CL_A && s1_last && s1_lane;
+  wire f_a_tail2 = s2_v && s2_cl == CL_A && s2_last && s2_lane;
+  wire [3:0] f_groups = bd_pend + a_busy + f_a_tail1 + f_a_tail2 + (fq_pend && fq_lane) +
+                        fres_valid + b_busy + g_full;
+  // Index and counter bounds, and the bookkeeping they rest on.
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(fe_state <= FE_HAND);
+      assert(phase <= P_LAST && b_ptr == phase);
+      assert(y_ptr <= Y_LAST && dphase <= D_LAST);
+      assert(bd_wptr <= BD_LAST && bd_cnt <= TAPS_N);
+      assert(a_i <= T_LAST && r_i <= T_LAST && a_cnt <= TAPS_N);
+      assert(a_base <= BD_LAST && a_addr <= BD_LAST);
+      assert(c_j <= J_LAST && rd_j <= J_LAST);
+      assert(a_la <= NBA_L && a_lb <= NTB_L && sq_la <= NC_L && sq_lb <= NC_L &&
+             w_la <= NP_L && w_lb <= NW_L);
+      if (c_state == C_RUN) assert(c_m <= C_LAST);
+      assert(f_wptr <= F_LAST && f_rptr <= F_LAST && f_old <= F_LAST && f_cnt <= FN_N);
+      if (cq_valid) assert(cq_j <= J_LAST);
+      if (pw_valid) assert(pw_j <= J_LAST);
+      if (q_we) assert(q_wj <= J_LAST);
+      assert(g_full <= 2'd2 && eq_n <= 2'd3 && eq_w == eq_r + eq_n);
+      assert(f_groups == {2'b00, eq_n});
+      // banks: the back end writes the bank after the unread ones
+      assert((wr_bank ^ rd_bank) == (g_full == 2'd1));
+      if (g_full == 2'd2) assert(!b_busy);
+      if (!b_busy) assert(c_state == C_IDLE && !cq_valid && !pw_valid && !q_we && !b_tags);
+      // the presented beat's words are the memories' words at the read address
+      if (m_valid)
+        assert(q_rd == q_mem[{rd_bank, rd_j}] && c_rd == c_mem[{rd_bank, rd_j}] &&
+               e_rd == e_mem[eq_r]);
+    end
+
+  // ---- no overflow: acc (moving sum of the B history)
+  localparam integer F_AW = DEC_W + 2;
+  reg signed [F_AW-1:0] f_bsum_re, f_bsum_im;
+  reg [2*MIX_W-1:0] f_bw;
+  integer f_i;
+  always @(*) begin
+    f_bsum_re = 0;
+    f_bsum_im = 0;
+    for (f_i = 0; f_i < PERIOD; f_i = f_i + 1) begin
+      f_bw = b_mem[f_i];
+      if (b_full || f_i < b_ptr) begin
+        f_bsum_re = f_bsum_re + $signed(f_bw[2*MIX_W-1:MIX_W]);
+        f_bsum_im = f_bsum_im + $signed(f_bw[MIX_W-1:0]);
+      end
+    end
+  end
+  wire signed [F_AW-1:0] f_acc_re_x = acc_re + mix_re - b_old_re;
+  wire signed [F_AW-1:0] f_acc_im_x = acc_im + mix_im - b_old_im;
+  always @(*)
+    if (f_past_valid && !rst) begin
+      // acc is the sum of the entries written since reset (computed wide: it fits)
+      assert(acc_re == f_bsum_re && acc_im == f_bsum_im);
+      if (fe_state == FE_M5) begin
+        assert(b_rd == b_mem[b_ptr]);
+        assert(f_acc_re_x[F_AW-1:DEC_W-1] == {(F_AW-DEC_W+1){f_acc_re_x[DEC_W-1]}});
+        assert(f_acc_im_x[F_AW-1:DEC_W-1] == {(F_AW-DEC_W+1){f_acc_im_x[DEC_W-1]}});
+      end
+    end
+
+  // ---- no overflow: E (running energy over the y history)
+  reg [WINDOW-1:0] f_yw;  // y history slot written since reset
+  always @(posedge clk)
+    if (rst) f_yw <= {WINDOW{1'b0}};
+    else if (fe_state == FE_M3) f_yw[y_ptr] <= 1'b1;
+  reg [EX_W-1:0] f_esum;
+  reg [WINDOW-1:0] f_ylt, f_yle;
+  reg signed [DATA_W-1:0] f_yv;
+  reg [2*DATA_W-1:0] f_ysq;
+  always @(*) begin
+    f_esum = {EX_W{1'b0}};
+    for (f_i = 0; f_i < WINDOW; f_i = f_i + 1) begin
+      f_yv = y_mem[f_i];
+      f_ysq = f_yv * f_yv;
+      if (f_yw[f_i]) f_esum = f_esum + f_ysq;
+      f_ylt[f_i] = (f_i < y_ptr);
+      f_yle[f_i] = (f_i <= y_ptr);
+    end
+  end
+  wire [2*DATA_W-1:0] f_fa2 = fa * fa;
+  wire signed [FB_W-1:0] f_fa_x = {{(FB_W-DATA_W){fa[DATA_W-1]}}, fa};
+  always @(*)
+    if (f_past_valid && !rst) begin
+      // the slots written: all once y_full, else those before the write pointer
+      if (y_full) assert(&f_yw);
+      else if (fe_state == FE_M1 || fe_state == FE_M2 || fe_state == FE_M3) assert(f_yw == f_ylt);
+      else if (fe_state == FE_M4 || fe_state == FE_M5) assert(f_yw == f_yle);
+      else assert(f_yw == ((y_ptr == Y_LAST) ? {WINDOW{1'b0}} : f_yle));
+      // E is the window's sum of y^2, plus the square in flight
+      if (fe_state == FE_M3 || fe_state == FE_M4 || fe_state == FE_M5)
+        assert(energy == f_esum + f_fa2);
+      else
+        assert(energy == f_esum);
+      if (fe_state == FE_M1 || fe_state == FE_M4) assert(fb == f_fa_x);
+      if (fe_state == FE_M2 || fe_state == FE_M5) assert(fp == f_fa2);
+      if (fe_state == FE_M3) assert(y_rd == y_mem[y_ptr]);
+      // E + y^2 and E - y_old^2 fit ENERGY_W bits unsigned (no overflow, no underflow)
+      if (fe_state == FE_M2 || fe_state == FE_M5) assert(energy_s[EX_W:ENERGY_W+1] == 0);
+    end
+
+`ifdef FORMAL_NARROW_PRODUCT
+  // the narrowed multiplier computes every issued product exactly
+  always @(*)
+    if (f_past_valid && !rst && s1_v) assert((ma >> F_MA_W) == 0 && (mb >> F_MB_W) == 0);
+`endif
+  // ---- no overflow: chip FIR accumulator, |Cq|^2 sum P, weighted Q (back-end adder)
+  localparam integer F_XW = XW + 2;
+  wire signed [F_XW-1:0] f_psh = {2'b00, psh};
+  wire signed [F_XW-1:0] f_fir_x = $signed(facc_base) + (s2_neg ? -f_psh : f_psh);
+  wire [F_XW-1:0] f_p_x = {{(F_XW-PW_W){1'b0}}, (s2_first ? {PW_W{1'b0}} : p_w)} + f_psh;
+  wire [F_XW-1:0] f_q_x = {{(F_XW-WEIGHTED_W){1'b0}}, (s2_first ? {WEIGHTED_W{1'b0}} : q_acc)} + f_psh;
+  always @(*)
+    if (f_past_valid && !rst && s2_v) begin
+      if (s2_cl == CL_A) assert(f_fir_x[F_XW-1:FIR_W-1] == {(F_XW-FIR_W+1){f_fir_x[FIR_W-1]}});
+      if (s2_cl == CL_SQ) assert(f_p_x[F_XW-1:PW_W] == 0);
+      if (s2_cl == CL_W) assert(f_q_x[F_XW-1:WEIGHTED_W] == 0);
+    end
+
+  // ---- no overflow: combiner accumulators C (f_cn: chips added in this round)
+  localparam integer F_CW = CA_W + 2;
+  reg [CI_W+1:0] f_cn;
+  always @(posedge clk)
+    if (rst || b_start || (c_state == C_Q && !cq_valid)) f_cn <= 0;
+    else if (c_iss1) f_cn <= f_cn + 1'b1;
+  wire signed [F_CW-1:0] f_fre = c_dv1 ? (c_neg ? -f_rd_re : f_rd_re) : 0;
+  wire signed [F_CW-1:0] f_fim = c_dv1 ? (c_neg ? -f_rd_im : f_rd_im) : 0;
+  wire signed [F_CW-1:0] f_ca_re_x = ca_re + f_fre;
+  wire signed [F_CW-1:0] f_ca_im_x = ca_im + f_fim;
+  wire signed [F_CW-1:0] f_clim = $signed({1'b0, f_cn}) <<< (CHIP_W - 1);
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(f_cn <= CHIPS);
+      if (c_state == C_RUN) assert(f_cn + c_iss1 == c_m && (c_iss1 || c_m == 0));
+      if (c_state == C_DRAIN) assert(c_iss1 && f_cn == CHIPS - 1);
+      if (c_state == C_Q) assert(!c_iss1 && f_cn == CHIPS);
+      if (c_state == C_IDLE) assert(!c_iss1 && f_cn == 0);
+      assert($signed(ca_re) <= f_clim && $signed(ca_re) >= -f_clim);
+      assert($signed(ca_im) <= f_clim && $signed(ca_im) >= -f_clim);
+      if (c_iss1) begin
+        assert(f_ca_re_x[F_CW-1:CA_W-1] == {(F_CW-CA_W+1){f_ca_re_x[CA_W-1]}});
+        assert(f_ca_im_x[F_CW-1:CA_W-1] == {(F_CW-CA_W+1){f_ca_im_x[CA_W-1]}});
+      end
+    end
+`endif
 endmodule
 
 `default_nettype wire
