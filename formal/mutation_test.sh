@@ -16,10 +16,30 @@ case "${1:-}" in -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;
 work=$(mktemp -d "${TMPDIR:-/tmp}/ranging-mutant-XXXXXX")
 trap 'rm -rf "$work"' EXIT
 cp "$root"/rtl/*.v "$work/"
-sed -i 's/end else if (byte_ready) begin/end else begin/' "$work/measurement_uart.v"
-if cmp -s "$root/rtl/measurement_uart.v" "$work/measurement_uart.v"; then
-  echo "mutation_test: the mutation did not apply (rtl/measurement_uart.v changed?)" >&2; exit 2
-fi
+# mutate FILE SED: apply one edit to the copy of rtl/FILE (exit 2 if it no longer applies)
+mutate() {
+  sed -i "$2" "$work/$1"
+  if cmp -s "$root/rtl/$1" "$work/$1"; then
+    echo "mutation_test: the mutation did not apply (rtl/$1 changed?)" >&2; exit 2
+  fi
+}
+# caught_at JOB FILE LINE WHAT: the abc job must fail on the assertion cell of LINE of FILE. A
+# cell is named after the line before its assert (its enclosing `if`, or the previous assert).
+caught_at() {
+  local msg rc
+  msg=$("$root/formal/run_formal.sh" "$1" --rtl "$work" --out "$work/out-$1" --bmc-only)
+  rc=$?
+  [[ $rc == 2 ]] && { echo "mutation_test: tool error" >&2; exit 2; }
+  if [[ $rc == 1 ]] && grep -q "$2:$(( $3 - 1 ))\\$" <<<"$msg"; then
+    echo "mutation_test: $4 is caught ($msg)"
+  else
+    echo "mutation_test: the $1 mutant was NOT caught as expected (run_formal exit $rc: $msg)" >&2
+    exit 1
+  fi
+}
+line_of() { grep -nF "$2" "$work/$1" | head -1 | cut -d: -f1; }
+
+mutate measurement_uart.v 's/end else if (byte_ready) begin/end else begin/'
 "$root/formal/run_formal.sh" measurement_uart --rtl "$work" --out "$work/out" --depth 20 --bmc-only
 rc=$?
 [[ $rc == 2 ]] && { echo "mutation_test: tool error" >&2; exit 2; }
@@ -30,36 +50,9 @@ else
   exit 1
 fi
 # the abc engine: the detector's event is dropped while it waits for m_ready
-cp "$root/rtl/peak_detector.v" "$work/peak_detector.v"
-sed -i 's/S_OUT: if (m_ready) state <= S_IDLE;/S_OUT: state <= S_IDLE;/' "$work/peak_detector.v"
-if cmp -s "$root/rtl/peak_detector.v" "$work/peak_detector.v"; then
-  echo "mutation_test: the mutation did not apply (rtl/peak_detector.v changed?)" >&2; exit 2
-fi
-# an assertion cell is named after the line before the assert (its enclosing `if`, or the
-# previous assert)
-held=$(grep -n 'assert(m_valid);' "$work/peak_detector.v" | head -1 | cut -d: -f1)
-msg=$("$root/formal/run_formal.sh" peak_detector --rtl "$work" --out "$work/out-pd" --bmc-only)
-rc=$?
-[[ $rc == 2 ]] && { echo "mutation_test: tool error" >&2; exit 2; }
-if [[ $rc == 1 ]] && grep -q "peak_detector.v:$((held - 1))\\$" <<<"$msg"; then
-  echo "mutation_test: the dropped event is caught ($msg)"
-else
-  echo "mutation_test: the peak_detector mutant was NOT caught as expected (run_formal exit $rc: $msg)" >&2
-  exit 1
-fi
+mutate peak_detector.v 's/S_OUT: if (m_ready) state <= S_IDLE;/S_OUT: state <= S_IDLE;/'
+caught_at peak_detector peak_detector.v "$(line_of peak_detector.v 'assert(m_valid);')" "the dropped event"
 # the filter's schedule no longer freezes while its output waits for m_ready
-cp "$root/rtl/bandpass_sos.v" "$work/bandpass_sos.v"
-sed -i 's/  wire                  run = !(out_valid \&\& !m_ready) \&\& !park;/  wire                  run = !park;/' "$work/bandpass_sos.v"
-if cmp -s "$root/rtl/bandpass_sos.v" "$work/bandpass_sos.v"; then
-  echo "mutation_test: the mutation did not apply (rtl/bandpass_sos.v changed?)" >&2; exit 2
-fi
-stable=$(grep -n 'assert(m_data == $past(m_data)' "$work/bandpass_sos.v" | head -1 | cut -d: -f1)
-msg=$("$root/formal/run_formal.sh" bandpass_sos --rtl "$work" --out "$work/out-bp" --bmc-only)
-rc=$?
-[[ $rc == 2 ]] && { echo "mutation_test: tool error" >&2; exit 2; }
-if [[ $rc == 1 ]] && grep -q "bandpass_sos.v:$((stable - 1))\\$" <<<"$msg"; then
-  echo "mutation_test: the overwritten output is caught ($msg)"
-  exit 0
-fi
-echo "mutation_test: the bandpass_sos mutant was NOT caught as expected (run_formal exit $rc: $msg)" >&2
-exit 1
+mutate bandpass_sos.v 's/  wire                  run = !(out_valid \&\& !m_ready) \&\& !park;/  wire                  run = !park;/'
+caught_at bandpass_sos bandpass_sos.v "$(line_of bandpass_sos.v 'assert(m_data == $past(m_data)')" "the overwritten output"
+exit 0

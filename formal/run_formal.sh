@@ -63,8 +63,8 @@ if [[ $engine == abc ]]; then
   # one AIGER model (assertions as bad states, assumptions as constraints; uninitialized
   # registers free at step 0), as SymbiYosys writes it for its abc engines
   yosys -q -l "$out/$job-yosys.log" -p "$rc $chp prep -top $top; flatten; memory_map; opt -fast; async2sync; \
-      chformal -assume -early; setundef -undriven -anyseq; opt -fast; delete -output; dffunmap; techmap; \
-      opt -fast; dffunmap; abc -g AND -fast; opt_clean; dffunmap; aigmap; tee -q -o $out/$job-asserts.txt select -list t:\$assert; \
+      chformal -assume -early; setundef -undriven -anyseq; opt -fast; delete -output; techmap; \
+      opt -fast; abc -g AND -fast; opt_clean; dffunmap; aigmap; tee -q -o $out/$job-asserts.txt select -list t:\$assert; \
       write_aiger -I -B -zinit -map $out/$job.aim $out/$job.aig" >/dev/null \
     || { echo "run_formal: yosys failed, see $out/$job-yosys.log" >&2; exit 2; }
   # bad-state outputs are numbered in the order of the model's assertion cells
