@@ -1,5 +1,7 @@
 // The fast paths of the golden model against the reference rules they replace:
 //   fx_quantize_fast<R, O>  vs fx_quantize (every rounding and overflow mode, every shift);
+//   quantize_input (the ADC model's int64 path) vs quantize_input_wide (128-bit), values and
+//     saturation counts, at the ties, beside them, at full scale and beyond;
 //   BandpassFixed::execute_block  vs a DF1 cascade written here with fx_quantize, for every
 //     mode, with overflows, section counts on both sides of the specialized kernels and
 //     blocks of random length (the state carries across blocks);
@@ -11,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <utility>
@@ -20,6 +23,7 @@
 #include "model/dsp/bandpass_filter.hpp"
 #include "model/dsp/filter_design.hpp"
 #include "model/dsp/fixed_point.hpp"
+#include "model/dsp/quantize.hpp"
 #include "model/dsp/receiver.hpp"
 
 using namespace ranging;
@@ -105,6 +109,37 @@ TEST(FastQuantizer, MatchesFxQuantizeForEveryModeShiftAndFormat) {
     }
   }
   EXPECT_GT(overflows, checked / 10);  // the overflow branch was exercised, not only the fast path
+}
+
+TEST(FastQuantizer, AdcQuantizerMatchesTheWideReferenceAtTiesEdgesAndBeyondFullScale) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.2, 1.2);
+  std::uniform_int_distribution<int> e(-1080, 8);
+  int compared = 0;
+  for (int bits : {2, 3, 8, 12, 16, 24, 32, 40, 41, 48}) {
+    std::vector<double> xs = {0.0, -0.0, 1.0, -1.0, 4.0, -4.0, std::nextafter(4.0, 5.0), std::nextafter(-4.0, -5.0),
+                              1e300, -1e300, 5e-324, -5e-324};
+    const double lsb = std::ldexp(1.0, -(bits - 1));
+    for (int k = -40; k <= 40; ++k) {  // the ties k + 1/2 LSB and the doubles beside them
+      const double t = (k + 0.5) * lsb;
+      for (double v : {t, std::nextafter(t, 1.0), std::nextafter(t, -1.0), k * lsb}) xs.push_back(v);
+    }
+    for (double top : {1.0 - 0.5 * lsb, -1.0 - 0.5 * lsb, 1.0, -1.0}) {  // the saturation thresholds
+      for (double v : {top, std::nextafter(top, 2.0), std::nextafter(top, -2.0)}) xs.push_back(v);
+    }
+    for (int i = 0; i < 20000; ++i) xs.push_back(i % 2 ? u(rng) : std::ldexp(u(rng), e(rng)));
+    OverflowCounter fast_count, wide_count;
+    for (double x : xs) {
+      ASSERT_EQ(quantize_input(x, bits, &fast_count), quantize_input_wide(x, bits, &wide_count))
+          << "bits " << bits << " x " << x;
+      ++compared;
+    }
+    EXPECT_EQ(fast_count.saturations, wide_count.saturations) << "bits " << bits;
+    EXPECT_GT(wide_count.saturations, 0u) << "bits " << bits;  // the edges above do saturate
+    EXPECT_EQ(fast_count.wraps, 0u);
+  }
+  EXPECT_GT(compared, 200000);
+  EXPECT_THROW(quantize_input(std::numeric_limits<double>::infinity(), 12, nullptr), InputError);
 }
 
 TEST(BandpassBlock, MatchesReferenceCascadeInEveryModeWithOverflowsAndAnySectionCount) {

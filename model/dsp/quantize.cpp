@@ -27,7 +27,7 @@ std::int64_t quantize_coefficient(double value, int bits, int frac, const std::s
   return static_cast<std::int64_t>(q);
 }
 
-std::int64_t quantize_input(double x, int bits, OverflowCounter* counter) {
+std::int64_t quantize_input_wide(double x, int bits, OverflowCounter* counter) {
   const FixedFormat fmt{bits, bits - 1, true, Rounding::RoundHalfUp, Overflow::Saturate};
   if (!std::isfinite(x)) throw InputError("receiver input: sample is not finite");
   // x * 2^(bits-1) with 20 guard bits below the LSB, so the rounding sees the true fraction.
@@ -35,6 +35,26 @@ std::int64_t quantize_input(double x, int bits, OverflowCounter* counter) {
   const double lim = std::ldexp(1.0, 100);
   const int128_t raw = static_cast<int128_t>(std::clamp(std::floor(scaled), -lim, lim));
   return fx_quantize(raw, bits - 1 + 20, fmt, counter);
+}
+
+std::int64_t quantize_input(double x, int bits, OverflowCounter* counter) {
+  if (!std::isfinite(x)) throw InputError("receiver input: sample is not finite");
+  // The int64 path: for 2 <= bits <= 40 and |x| <= 4, floor(x * 2^(bits-1+20)) is exact
+  // (a power-of-two scaling) and |floor| <= 2^61, so the same 20 guard bits, round half up
+  // ((f >> 20) + bit 19 of f: floor((f + 2^19) / 2^20)) and saturation as quantize_input_wide,
+  // without its int128 conversion. Anything else (|x| > 4 always saturates) takes the wide path.
+  if (bits >= 2 && bits <= 40 && std::abs(x) <= 4.0) {
+    const double scaled = x * static_cast<double>(std::int64_t{1} << (bits - 1 + 20));
+    const auto f = static_cast<std::int64_t>(std::floor(scaled));
+    const std::int64_t q = (f >> 20) + ((f >> 19) & 1);  // arithmetic shifts (C++20): floor
+    const std::int64_t hi = (std::int64_t{1} << (bits - 1)) - 1;
+    if (q > hi || q < -hi - 1) [[unlikely]] {
+      if (counter) ++counter->saturations;
+      return q > hi ? hi : -hi - 1;
+    }
+    return q;
+  }
+  return quantize_input_wide(x, bits, counter);
 }
 
 }  // namespace ranging

@@ -19,6 +19,9 @@
 namespace ranging {
 
 std::int64_t quantize_input(double x, int bits, OverflowCounter* counter);
+// The same function through a 128-bit intermediate for every argument (the reference that
+// quantize_input's int64 path is tested against: tests/test_quantize.cpp).
+std::int64_t quantize_input_wide(double x, int bits, OverflowCounter* counter);
 
 std::int64_t quantize_coefficient(double value, int bits, int frac, const std::string& field);
 
