@@ -142,6 +142,28 @@ TEST(FastQuantizer, AdcQuantizerMatchesTheWideReferenceAtTiesEdgesAndBeyondFullS
   EXPECT_THROW(quantize_input(std::numeric_limits<double>::infinity(), 12, nullptr), InputError);
 }
 
+TEST(FastQuantizer, RoundHalfAwayIsStdRoundBitForBit) {
+  std::vector<double> xs = {0.0, -0.0, 0.5, -0.5, 1.5, -1.5, 2.5, -2.5, 0.49999999999999994, -0.49999999999999994,
+                            4503599627370495.5, -4503599627370495.5, 4503599627370496.0, 9007199254740993.0, 1e300,
+                            -1e300, 5e-324, -5e-324, std::numeric_limits<double>::infinity(),
+                            -std::numeric_limits<double>::infinity()};
+  for (int k = -3000; k <= 3000; ++k) {
+    const double t = k + 0.5;
+    for (double v : {t, std::nextafter(t, 1e9), std::nextafter(t, -1e9), static_cast<double>(k)}) xs.push_back(v);
+  }
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_int_distribution<int> e(-60, 60);
+  for (int i = 0; i < 200000; ++i) xs.push_back(std::ldexp(u(rng), e(rng)));
+  for (double v : xs) {
+    const double want = std::round(v);
+    const double got = round_half_away(v);
+    ASSERT_EQ(std::signbit(got), std::signbit(want)) << v;
+    ASSERT_EQ(got, want) << std::hexfloat << v;
+  }
+  EXPECT_TRUE(std::isnan(round_half_away(std::nan(""))));
+}
+
 TEST(BandpassBlock, MatchesReferenceCascadeInEveryModeWithOverflowsAndAnySectionCount) {
   std::mt19937_64 rng(11);
   // Butterworth: b0 [1, 0, -1] numerators (the one-multiply kernel); elliptic: general

@@ -232,3 +232,99 @@ TEST(SceneSimulator, PeriodicTrainDecodesEveryBurstWithItsOwnTof) {
     EXPECT_NEAR(r.distance_m, 1.0, 1e-3);
   }
 }
+
+// receiver.metrics: a metric the scene does not name is not computed (NaN, no Pearson
+// decoder), and what the receiver decodes does not depend on it.
+TEST(SceneMetrics, UnnamedMetricsAreNotComputedAndTheReceiverDecodeIsUnchanged) {
+  const std::string base = "transducers: {}\ngeometry:\n  distances_m: [0.3, 0.7]\n  repeats: 2\n"
+                           "excitation:\n  family: M1\nnoise:\n  noise_v: 0.004\n  seed: 3\n";
+  auto run = [&](const std::string& metrics, const std::string& precision) {
+    std::string y = base + "receiver:\n  precision: " + precision + "\n";
+    if (!metrics.empty()) y += "  metrics: " + metrics + "\n";
+    const Scene sc = parse_scene(y, "s.yaml");
+    SceneSimulator sim(sc);
+    auto rows = sim.run("M1");
+    return std::make_pair(rows, summarize(sc, "M1", rows));
+  };
+  for (const std::string prec : {"float", "fixed"}) {
+    const auto [all, sall] = run("", prec);
+    ASSERT_EQ(all.size(), 28u);
+    const auto [none, snone] = run("[]", prec);
+    const auto [pearson, sp] = run("[pearson]", prec);
+    const auto [et, set] = run("[energy, td]", prec);
+    for (const auto* v : {&none, &pearson, &et}) {
+      ASSERT_EQ(v->size(), all.size());
+      for (std::size_t i = 0; i < all.size(); ++i) {  // the receiver's decode, bit for bit
+        EXPECT_EQ((*v)[i].detected, all[i].detected) << prec << " " << i;
+        EXPECT_EQ((*v)[i].det.code, all[i].det.code);
+        EXPECT_EQ((*v)[i].det.tof_s, all[i].det.tof_s);
+        EXPECT_EQ((*v)[i].det.score, all[i].det.score);
+        EXPECT_EQ((*v)[i].error_m, all[i].error_m);
+      }
+    }
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      EXPECT_FALSE(all[i].det.rho.empty());
+      EXPECT_TRUE(std::isfinite(all[i].det.energy) && std::isfinite(all[i].det.td_s));
+      EXPECT_TRUE(none[i].det.rho.empty());
+      EXPECT_TRUE(std::isnan(none[i].det.rho_max) && std::isnan(none[i].u));
+      EXPECT_TRUE(std::isnan(none[i].det.energy) && std::isnan(none[i].det.td_s));
+      EXPECT_FALSE(none[i].pearson_error);  // no Pearson decoder, no Pearson error
+      EXPECT_EQ(pearson[i].det.rho, all[i].det.rho);
+      EXPECT_EQ(pearson[i].u, all[i].u);
+      EXPECT_TRUE(std::isnan(pearson[i].det.energy) && std::isnan(pearson[i].det.td_s));
+      EXPECT_EQ(et[i].det.energy, all[i].det.energy);
+      EXPECT_EQ(et[i].det.td_s, all[i].det.td_s);
+      EXPECT_TRUE(et[i].det.rho.empty());
+    }
+    EXPECT_TRUE(std::isfinite(sall.u_min) && std::isfinite(sall.energy_min) && std::isfinite(sall.vmax_hz));
+    EXPECT_TRUE(std::isnan(snone.u_min) && std::isnan(snone.energy_min) && std::isnan(snone.td_max_s) &&
+                std::isnan(snone.vmax_hz));
+    EXPECT_EQ(snone.pearson_errors, 0u);
+    EXPECT_EQ(snone.decode_errors, snone.detector_errors + snone.range_ambiguous);
+    EXPECT_EQ(snone.rmse_m, sall.rmse_m);
+    EXPECT_EQ(sp.u_min, sall.u_min);
+    EXPECT_EQ(set.td_max_s, sall.td_max_s);
+    EXPECT_EQ(set.energy_min, sall.energy_min);
+  }
+}
+
+TEST(SceneMetrics, BadMetricsListsNameTheEntryAndTheValidNames) {
+  auto has = [](const std::string& yaml, const std::string& what) {
+    const std::string e = error_of(yaml);
+    EXPECT_NE(e.find(what), std::string::npos) << "error: '" << e << "' for:\n" << yaml;
+  };
+  has(kMinimal + "receiver:\n  metrics: [pearson, rho]\n",
+      "s.yaml:4: receiver.metrics: metrics[1]: 'rho' is not valid; valid: pearson, energy, td");
+  has(kMinimal + "receiver:\n  metrics: [td, td]\n", "receiver.metrics: metrics[1]: 'td' is listed twice");
+  has(kMinimal + "receiver:\n  metrics: pearson\n", "receiver.metrics: expected a list");
+}
+
+TEST(SceneMetrics, SimulateMarksWhatItDidNotComputeAndEvaluateRefusesIt) {
+  const std::string dir = ::testing::TempDir() + "/sim_metrics_" + std::to_string(::getpid());
+  std::filesystem::remove_all(dir);
+  const std::string scene = std::string(RANGING_SOURCE_DIR) + "/scenes/default.yaml";
+  const ToolRun r = run_tool("simulate " + scene + " --set 'receiver.metrics=[td]' --json --quiet --out " + dir);
+  ASSERT_EQ(r.status, 0);
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["metrics"], nlohmann::json::array({"td"}));
+  EXPECT_GT(j["samples_simulated"].get<std::uint64_t>(), 100000u);
+  const auto& f = j["families"][0];
+  EXPECT_TRUE(f["pearson"].is_null());
+  EXPECT_TRUE(f["u_min"].is_null());
+  EXPECT_TRUE(f["energy_min_v2"].is_null());
+  EXPECT_TRUE(f["td_max_s"].is_number());
+  std::ifstream csv(dir + "/measurements.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  std::getline(csv, line);
+  EXPECT_EQ(line.find(",,,,"), line.find(",,"));  // rho_max, rho_submax, u, energy_v2 empty
+  EXPECT_NE(line.find(",,,,"), std::string::npos) << line;
+  const ToolRun text = run_tool("simulate " + scene + " --set 'receiver.metrics=[]' --quiet --out " + dir + "_t");
+  ASSERT_EQ(text.status, 0);
+  EXPECT_NE(text.out.find("not computed (receiver.metrics): pearson, energy, td"), std::string::npos) << text.out;
+  const ToolRun ev = run_tool("evaluate " + scene + " --set 'receiver.metrics=[]' --out " + dir + "_e");
+  EXPECT_EQ(ev.status, 2);
+  EXPECT_TRUE(ev.out.empty());
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(dir + "_t");
+}

@@ -182,6 +182,10 @@ int cmd_decode(const Args& args) {
        << "\ntransducers: {}\ngeometry:\n  distances_m: [1.0]\nexcitation:\n  family: " << family << "\n";
   if (p.has("--references")) yaml << "receiver:\n  reference: files\n  references_dir: \"" << *p.get("--references") << "\"\n";
   Scene scene = parse_scene(yaml.str(), path, ".", parse_overrides(p.values("--set")), p.has("--allow-out-of-spec"));
+  if (!scene.receiver.metrics.pearson) {  // --min-rho selects the bursts by the Pearson rho
+    throw InputError("option --set: receiver.metrics: decode reports bursts by their Pearson rho (--min-rho); "
+                     "the metrics must include pearson");
+  }
   warn_if_out_of_spec("decode", scene.receiver.config);
   const CodeFamily fam = code_family(family);
   const std::size_t burst = static_cast<std::size_t>(fam.length + 3) * static_cast<std::size_t>(scene.receiver.config.chip_samples());

@@ -508,6 +508,10 @@ int cmd_evaluate(const Args& args) {
   const std::string scene_path = p.positionals().at(0);
   Overrides overrides;
   const Scene scene = load_scene_options(p, "evaluate", &overrides);
+  if (!scene.receiver.metrics.all()) {  // Tables 4 and 5 are the metrics themselves
+    throw InputError(scene.origin + ": receiver.metrics: evaluate reproduces the paper's u, energy and T_d; "
+                     "the scene must compute all three (valid: [pearson, energy, td], the default)");
+  }
   const std::string out = p.get_or("--out", "out/" + scene.name);
   OutputDir out_dir(out, "option --out");  // removed again if the run fails
 

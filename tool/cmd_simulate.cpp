@@ -179,6 +179,8 @@ nlohmann::json summary_json(const SceneSimulator& sim, const SceneRun& run) {
                                      : nlohmann::json(nullptr);
   j["warnings"] = s.warnings;
   j["max_range_m"] = s.range_l();
+  j["metrics"] = s.receiver.metrics.names();  // receiver.metrics: the others are null below
+  j["samples_simulated"] = sim.samples_simulated();
   j["stages"] = nlohmann::json::array();
   for (const auto& st : sim.stages()) j["stages"].push_back({{"name", st.name}, {"description", st.description}});
   j["families"] = nlohmann::json::array();
@@ -202,9 +204,11 @@ nlohmann::json summary_json(const SceneSimulator& sim, const SceneRun& run) {
                              {"detector", {{"metric", "receiver rho^2 (hardware detector)"},
                                            {"decode_errors", f.detector_errors},
                                            {"rho2_margin_min", jnum(f.detector_margin_min)}}},
-                             {"pearson", {{"metric", "paper: Pearson matched filter over +-L chips, u by eq. 10"},
-                                          {"decode_errors", f.pearson_errors}, {"u_min", jnum(f.u_min)},
-                                          {"u_max_over_min", jnum(f.u_max_over_min)}}},
+                             {"pearson", s.receiver.metrics.pearson
+                                             ? nlohmann::json{{"metric", "paper: Pearson matched filter over +-L chips, u by eq. 10"},
+                                                              {"decode_errors", f.pearson_errors}, {"u_min", jnum(f.u_min)},
+                                                              {"u_max_over_min", jnum(f.u_max_over_min)}}
+                                             : nlohmann::json(nullptr)},
                              {"td_clipped", f.td_clipped}, {"td_noise_limited", f.td_noise_limited},
                              {"input_clipping", {{"stage", s.noise.adc ? "adc" : "receiver input clamp"},
                                                  {"measurements_clipped", f.clipped_measurements},
@@ -339,17 +343,33 @@ int cmd_simulate(const Args& args) {
                   "eta", "n", "errors", "det.err", "prs.err", "rmse_mm", "rho2_mrg", "u_min", "energy_min", "Td_max_us",
                   "vmax_Hz", "Td_clip", "Td_noise");
     text << line;
+    const SceneMetrics& mt = scene.receiver.metrics;
     for (const auto& f : run.summaries) {
-      std::snprintf(line, sizeof line, "%-8s %4d %6zu %7zu %7zu %7zu %10.4f %10.4f %9.4f %11.4g %9.1f %9.0f %7zu %8zu\n",
-                    f.family.c_str(), f.eta, f.measurements, f.decode_errors, f.detector_errors, f.pearson_errors,
-                    f.rmse_m * 1e3, f.detector_margin_min, f.u_min, f.energy_min, f.td_max_s * 1e6, f.vmax_hz,
-                    f.td_clipped, f.td_noise_limited);
+      // A metric the scene does not compute prints "-", never a 0 that reads as a result.
+      const auto cell = [](bool on, const char* fmt, auto v) {
+        char b[32];
+        if (!on) return std::string("-");
+        std::snprintf(b, sizeof b, fmt, v);
+        return std::string(b);
+      };
+      std::snprintf(line, sizeof line, "%-8s %4d %6zu %7zu %7zu %7s %10.4f %10.4f %9s %11s %9s %9s %7s %8s\n",
+                    f.family.c_str(), f.eta, f.measurements, f.decode_errors, f.detector_errors,
+                    cell(mt.pearson, "%zu", f.pearson_errors).c_str(), f.rmse_m * 1e3, f.detector_margin_min,
+                    cell(mt.pearson, "%.4f", f.u_min).c_str(), cell(mt.energy, "%.4g", f.energy_min).c_str(),
+                    cell(mt.td, "%.1f", f.td_max_s * 1e6).c_str(), cell(mt.td, "%.0f", f.vmax_hz).c_str(),
+                    cell(mt.td, "%zu", f.td_clipped).c_str(), cell(mt.td, "%zu", f.td_noise_limited).c_str());
       text << line;
     }
     text << "errors = missed or misdecoded by either decoder; det.err / rho2_mrg: the receiver's (hardware)\n"
             "rho^2 detector and its smallest per-code mean margin; prs.err / u_min: the paper's Pearson\n"
             "matched filter (+-L chips) and eq. 10's u; Td_clip / Td_noise: T_d measurements the search\n"
             "range clipped / whose threshold the noise floor set (docs/signal-model.md)\n";
+    if (!mt.all()) {
+      const SceneMetrics none{!mt.pearson, !mt.energy, !mt.td};
+      std::string off;
+      for (const auto& m : none.names()) off += (off.empty() ? "" : ", ") + m;
+      text << "not computed (receiver.metrics): " << off << " (\"-\" above, empty in measurements.csv)\n";
+    }
     for (const auto& f : run.summaries) {
       if (f.clipped_measurements > 0) {
         text << "warning: " << f.family << ": input clipped (" << (scene.noise.adc ? "ADC" : "receiver input clamp")

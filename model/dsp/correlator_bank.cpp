@@ -230,6 +230,17 @@ void CorrelatorBankFloat::reset() {
   y2_.assign(static_cast<std::size_t>(ref_.window), 0.0);
   y_idx_ = y2_.size() - 1;
   q_.assign(ref_.codes.size(), 0.0);
+  c_re_.assign(q_.size(), 0.0);
+  c_im_.assign(q_.size(), 0.0);
+  f_last_re_ = f_last_im_ = 0;
+}
+
+double CorrelatorBankFloat::chip_magnitude() const { return std::hypot(f_last_re_, f_last_im_); }
+
+double CorrelatorBankFloat::max_corr_magnitude() const {
+  double m = 0;
+  for (std::size_t j = 0; j < q_.size(); ++j) m = std::max(m, std::hypot(c_re_[j], c_im_[j]));
+  return m;
 }
 
 bool CorrelatorBankFloat::execute(double y) {
@@ -261,8 +272,8 @@ bool CorrelatorBankFloat::execute(double y) {
   if (++f_idx_ == f_n_) f_idx_ = 0;
   f_re_[f_idx_] = f_re_[f_idx_ + f_n_] = fre;
   f_im_[f_idx_] = f_im_[f_idx_ + f_n_] = fim;
-  chip_mag_ = std::hypot(fre, fim);
-  corr_mag_ = 0;
+  f_last_re_ = fre;
+  f_last_im_ = fim;
 
   const std::size_t step = static_cast<std::size_t>(ref_.chip_samples / ref_.decimation);
   for (std::size_t j = 0; j < q_.size(); ++j) {
@@ -274,7 +285,8 @@ bool CorrelatorBankFloat::execute(double y) {
       cim += s * f_im_[k];
     }
     q_[j] = (cre * cre + cim * cim) / ref_.code_gain[j];
-    corr_mag_ = std::max(corr_mag_, std::hypot(cre, cim));
+    c_re_[j] = cre;
+    c_im_[j] = cim;
   }
   return true;
 }

@@ -96,8 +96,10 @@ class CorrelatorBankFloat {
   const std::vector<double>& weighted_power() const { return q_; }  // Q_j = P_j / K_j
   double energy() const { return energy_; }
   double rho2(int code) const { return energy_ > 0 ? q_.at(code) / energy_ : 0.0; }
-  double chip_magnitude() const { return chip_mag_; }  // |F| of the last output
-  double max_corr_magnitude() const { return corr_mag_; }  // max_j |C_j| of the last output
+  // |F| and max_j |C_j| of the last output (std::hypot, computed when asked: only the
+  // design-time scaling probe reads them, so the per-output path keeps F and C_j instead).
+  double chip_magnitude() const;
+  double max_corr_magnitude() const;
   std::int64_t sample_index() const { return n_ - 1; }  // full-rate index of the last input
   int codes() const { return static_cast<int>(q_.size()); }
   const CorrelatorReference& reference() const { return ref_; }
@@ -117,8 +119,8 @@ class CorrelatorBankFloat {
   std::vector<double> y2_;                     // y^2 history, W long
   std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0, bd_n_ = 0, f_n_ = 0;
   int dec_phase_ = 0;
-  double energy_ = 0, chip_mag_ = 0, corr_mag_ = 0;
-  std::vector<double> q_;
+  double energy_ = 0, f_last_re_ = 0, f_last_im_ = 0;
+  std::vector<double> q_, c_re_, c_im_;  // Q_j and C_j of the last output
 };
 
 class CorrelatorBankFixed {

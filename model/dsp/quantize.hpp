@@ -11,6 +11,7 @@
 // BandpassFixed::execute(double) all call it): x in full-scale units -> the signed `bits`
 // integer round_half_up(x * 2^(bits-1)), saturated to [-2^(bits-1), 2^(bits-1) - 1] and each
 // saturation counted in *counter (when not null). InputError when x is not finite.
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -19,6 +20,18 @@
 namespace ranging {
 
 std::int64_t quantize_input(double x, int bits, OverflowCounter* counter);
+
+// std::round (to nearest, ties away from zero) without the libm call: for |v| < 2^52 the
+// integer part i = trunc(v) (one conversion) and v - i are exact, so i +- 1 on |v - i| >= 1/2
+// is the same result bit for bit; anything else (|v| >= 2^52 is integral, NaN, inf) goes to
+// std::round. tests/test_block_api.cpp compares the two.
+inline double round_half_away(double v) {
+  if (!(std::abs(v) < 4503599627370496.0)) return std::round(v);
+  const auto i = static_cast<std::int64_t>(v);
+  const double frac = v - static_cast<double>(i);
+  const double r = static_cast<double>(i + (frac >= 0.5) - (frac <= -0.5));
+  return r == 0.0 ? std::copysign(0.0, v) : r;  // std::round keeps the sign of a zero
+}
 // The same function through a 128-bit intermediate for every argument (the reference that
 // quantize_input's int64 path is tested against: tests/test_quantize.cpp).
 std::int64_t quantize_input_wide(double x, int bits, OverflowCounter* counter);

@@ -25,6 +25,14 @@ double Scene::speed() const {
   return 340.0;  // the paper's value
 }
 
+std::vector<std::string> SceneMetrics::names() const {
+  std::vector<std::string> v;
+  if (pearson) v.push_back("pearson");
+  if (energy) v.push_back("energy");
+  if (td) v.push_back("td");
+  return v;
+}
+
 double Scene::receiver_speed() const { return receiver.speed_of_sound.value_or(speed()); }
 
 double Scene::unambiguous_range_m(int eta) const {
@@ -224,6 +232,19 @@ void read_receiver(Reader& r, Scene& s, const std::string& base_dir, const Overr
   r.get_range("calibration_distance_m", rc.calibration_distance_m, 0.01, 20);
   double c = 0;
   if (r.get_range("speed_of_sound", c, 100, 10000)) rc.speed_of_sound = c;
+  std::vector<std::string> metrics;
+  if (r.get_list("metrics", metrics)) {
+    rc.metrics = {false, false, false};
+    for (std::size_t i = 0; i < metrics.size(); ++i) {
+      const std::string& m = metrics[i];
+      bool* flag = m == "pearson" ? &rc.metrics.pearson : m == "energy" ? &rc.metrics.energy
+                                                        : m == "td"     ? &rc.metrics.td : nullptr;
+      const std::string at = "metrics[" + std::to_string(i) + "]";
+      if (!flag) r.error("metrics", at + ": '" + m + "' is not valid; valid: pearson, energy, td (or [] for none)");
+      if (*flag) r.error("metrics", at + ": '" + m + "' is listed twice");
+      *flag = true;
+    }
+  }
 }
 
 // The receiver follows the excitation and the sample rate; the combination is checked now so a

@@ -84,6 +84,19 @@ struct SceneNoise {
   std::optional<SceneAdc> adc;    // ADC stage
 };
 
+// The paper's metrics computed per measurement (receiver.metrics: a list of pearson, energy,
+// td; all three by default, [] for none). pearson: rho (eq. 9) and u (eq. 10) by the matched
+// filter over +-L chips, and the Pearson decoder's errors; energy: the burst window's V^2;
+// td: T_d (section 2.2) and v_max from it. A metric not named is not computed (NaN / null in
+// the outputs), and with none the float bandpass that feeds them does not run either: the
+// receiver's decode, ToF and distance are all that is modelled.
+struct SceneMetrics {
+  bool pearson = true, energy = true, td = true;
+  bool any() const { return pearson || energy || td; }
+  bool all() const { return pearson && energy && td; }
+  std::vector<std::string> names() const;  // the ones computed, in that order
+};
+
 struct SceneReceiver {
   ReceiverConfig config;            // family/q/carrier/fs follow the excitation and the scene
   std::string precision = "float";  // float | fixed
@@ -94,6 +107,7 @@ struct SceneReceiver {
   // The c the receiver converts ToF to distance with (receiver.speed_of_sound); unset: the
   // channel's c (Scene::speed()). With compensation it is replaced by each measurement's c_est.
   std::optional<double> speed_of_sound;
+  SceneMetrics metrics;
 };
 
 // Sound-velocity compensation (paper section 3.1, issue 14 section 6): with every measurement

@@ -264,9 +264,10 @@ struct SceneSimulator::Link {
     std::vector<Event> ev;
     const double inv = 1.0 / scale;
     ReceiverFloat rf(design);
+    const bool keep = scene->receiver.metrics.any();  // the filtered stream feeds the metrics only
     for (std::size_t n = 0; n < volts.size(); ++n) {
       if (auto e = rf.execute(volts[n] * inv)) ev.push_back(*e);
-      filtered[n] = rf.filtered() * scale;
+      if (keep) filtered[n] = rf.filtered() * scale;
     }
     if (auto e = rf.flush()) ev.push_back(*e);
     return ev;
@@ -294,7 +295,9 @@ struct SceneSimulator::Link {
         q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
       }
       rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
-      for (std::size_t n = n0; n < n1; ++n) filtered[n] = bp.execute(volts[n]);
+      if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only
+        for (std::size_t n = n0; n < n1; ++n) filtered[n] = bp.execute(volts[n]);
+      }
     }
     for (const auto& e : raw_events) ev.push_back(rx.to_float(e));
     if (auto e = rx.flush()) ev.push_back(*e);
@@ -518,20 +521,30 @@ struct SceneSimulator::Link {
     const long p0 = std::clamp<long>(start, 0, n - 1);
     const long p1 = std::clamp<long>(start + W, p0 + 1, n);
     const long hi_w = std::min(hi, avail);
-    try {
-      const StreamDuration td =
-          duration_td_stream(w, static_cast<std::size_t>(lo - base), static_cast<std::size_t>(hi_w - base),
-                             static_cast<std::size_t>(p0 - base), static_cast<std::size_t>(p1 - base),
-                             static_cast<std::size_t>(2 * spc), fs());
-      if (hi_w < hi && !td.ended_forward) return false;
-      d.td_s = td.seconds;
-      d.td_clipped = td.clipped;
-      d.td_noise_limited = td.noise_limited;
-    } catch (const InputError&) {
-      d.td_s = 0;
-      d.td_clipped = true;
+    const SceneMetrics& mt = scene->receiver.metrics;  // only the metrics the scene names
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (!mt.td) {
+      d.td_s = nan;
+    } else {
+      try {
+        const StreamDuration td =
+            duration_td_stream(w, static_cast<std::size_t>(lo - base), static_cast<std::size_t>(hi_w - base),
+                               static_cast<std::size_t>(p0 - base), static_cast<std::size_t>(p1 - base),
+                               static_cast<std::size_t>(2 * spc), fs());
+        if (hi_w < hi && !td.ended_forward) return false;
+        d.td_s = td.seconds;
+        d.td_clipped = td.clipped;
+        d.td_noise_limited = td.noise_limited;
+      } catch (const InputError&) {
+        d.td_s = 0;
+        d.td_clipped = true;
+      }
     }
-    if (start - reach <= n - W && start + reach >= 0 && n >= W) {
+    if (!mt.pearson) {
+      d.rho.clear();
+      d.pearson_code = 0;
+      d.rho_max = d.rho_submax = d.pearson_margin = nan;
+    } else if (start - reach <= n - W && start + reach >= 0 && n >= W) {
       const auto best = pb.search(w, start - reach - base, start + reach - base);
       d.rho.clear();
       for (const auto& b : best) d.rho.push_back(b.rho);
@@ -541,7 +554,9 @@ struct SceneSimulator::Link {
       d.rho_submax = dist.rho_submax;
       d.pearson_margin = dist.u;
     }
-    if (start >= 0 && start + W <= n) {
+    if (!mt.energy) {
+      d.energy = nan;
+    } else if (start >= 0 && start + W <= n) {
       d.energy = energy(w.subspan(static_cast<std::size_t>(start - base), template_len));
     }
     return true;
@@ -685,7 +700,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       const double top = std::ldexp(1.0, a.bits - 1);
       const auto mask = (std::uint64_t{1} << a.bits) - 1;
       for (std::size_t n = 0; n < x.size(); ++n) {
-        const double r = std::round((x[n] + a.dc_offset_v) / q);
+        const double r = round_half_away((x[n] + a.dc_offset_v) / q);  // std::round, inlined
         if (r < -top || r > top - 1) clipped.push_back(n);
         auto code = static_cast<std::int64_t>(std::clamp(r, -top, top - 1));
         if (a.stuck_bit >= 0) {  // two's complement of `bits` bits, the bit forced, sign-extended back
@@ -704,6 +719,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     std::vector<Measurement> rows;
     std::size_t fa = 0;
     std::uint64_t ovf = 0;
+    std::uint64_t samples = 0;  // received samples simulated (the measurement's and its reference's)
     std::vector<double> x;
   };
   const bool keep_x = static_cast<bool>(capture);
@@ -730,6 +746,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     add_noise_and_adc(x, sigma, d, rep, train, 0, clipped);
     std::vector<double> f;
     const auto ev = lk.receive(x, lk.input_scale(), f, &out.ovf, s.noise.adc ? nullptr : &clipped);
+    out.samples += x.size();
     const auto dets = lk.detections(ev, f, 0.0, train, pb);
     // Compensation: the reference path measures c (SceneCompensation).
     double c_est = s.receiver_speed();
@@ -746,6 +763,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       add_noise_and_adc(xr, sigma, d, rep, train, 1, rclip);
       std::vector<double> fr;
       const auto rev = lk.receive(xr, lk.input_scale(), fr, &out.ovf);
+      out.samples += xr.size();
       const auto rdets = lk.detections(rev, fr, 0.0, {rb}, pb);
       const double rtruth = dref / lk.c() * s.fs;
       int rbest = -1;
@@ -799,7 +817,8 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
         if (k + 1 < train.size()) end = std::lround((train[k + 1].tx_s + d / lk.c()) * s.fs);
         lk.metrics(m.det, f, std::lround(truth), end, pb);
       }
-      m.pearson_error = m.det.rho.empty() || m.det.pearson_code != m.code_sent;
+      // Without the pearson metric there is no Pearson decoder to err.
+      m.pearson_error = s.receiver.metrics.pearson && (m.det.rho.empty() || m.det.pearson_code != m.code_sent);
       m.u = m.det.rho.empty() ? std::nan("") : u_for_sent(m.det.rho, m.code_sent);
       out.rows.push_back(m);
     }
@@ -818,6 +837,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     rows.insert(rows.end(), o.rows.begin(), o.rows.end());
     fa += o.fa;
     lk.overflows += o.ovf;
+    samples_ += o.samples;
     if (tick) tick();
   };
   // The fixed-stream observer sees the streams in order: one thread then.
@@ -900,6 +920,14 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
   const auto ev = lk.receive_events(src, scale, block);
   const long s0 = std::lround(t0 * scene_.fs);
   auto pend = lk.prepare(ev, n, static_cast<double>(s0) / scene_.fs, schedule);
+  if (!scene_.receiver.metrics.any()) {  // no metric named: no third pass (the fields set to NaN)
+    std::vector<Detection> out;
+    for (auto& p : pend) {
+      (void)lk.metrics_window(p.d, {}, 0, n, p.start, p.end, *lk.bank);
+      out.push_back(std::move(p.d));
+    }
+    return out;
+  }
   // Pass 3: the filtered stream (receive()'s, in capture units) through a sliding window that
   // holds what the bursts whose metrics are pending need (Link::need), oldest first.
   std::vector<Link::Need> needs;
@@ -1007,13 +1035,15 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
       usum[j] += r.u;
       un[j] += 1;
     }
-    if (r.true_distance_m == dmax) {
+    if (r.true_distance_m == dmax && scene.receiver.metrics.energy) {
       esum[j] += r.det.energy;
       en[j] += 1;
     }
-    auto& t = td[{r.code_sent, std::llround(r.true_distance_m * 1e9)}];
-    t.first += r.det.td_s;
-    t.second += 1;
+    if (scene.receiver.metrics.td) {
+      auto& t = td[{r.code_sent, std::llround(r.true_distance_m * 1e9)}];
+      t.first += r.det.td_s;
+      t.second += 1;
+    }
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
@@ -1053,6 +1083,7 @@ FamilySummary summarize(const Scene& scene, const std::string& family, const std
   s.error_rate = s.measurements ? static_cast<double>(s.decode_errors) / static_cast<double>(s.measurements) : 0;
   s.rmse_m = nse ? std::sqrt(se / static_cast<double>(nse)) : nan;
   s.distance_rmse_with_ambiguous_m = nse_all ? std::sqrt(se_all / static_cast<double>(nse_all)) : nan;
+  if (!scene.receiver.metrics.td) s.td_max_s = nan;  // not computed, not 0
   const double L = scene.range_l();
   s.vmax_hz = s.td_max_s > 0 ? vmax(s.td_max_s, s.eta, scene.speed(), L) : nan;
   return s;

@@ -145,6 +145,9 @@ class SceneSimulator {
                                const std::function<void()>& tick = {},
                                const std::function<void(const CaptureStream&)>& capture = {},
                                std::size_t* false_alarms = nullptr, std::uint64_t* overflows = nullptr);
+  // Received samples that run() has simulated so far (every stream, compensation references
+  // included; calibration not): the denominator of a per-sample speed.
+  std::uint64_t samples_simulated() const { return samples_; }
   // Number of receiver runs (streams) of run(family), for progress bars.
   std::size_t streams(const std::string& family) const;
 
@@ -190,6 +193,7 @@ class SceneSimulator {
   std::vector<std::unique_ptr<Link>> links_;
   FixedStreamObserver observer_;
   int jobs_ = 1;
+  std::uint64_t samples_ = 0;
 };
 
 FamilySummary summarize(const Scene& scene, const std::string& family,
