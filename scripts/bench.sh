@@ -5,6 +5,7 @@
 #     (scripts/bench_sosfilt.py) and vs SystemC sc_fixed / sc_fix (bench/bench_fixed_point);
 #   the Verilator RTL of receiver_top vs the model (tb/bench_receiver_top);
 #   streaming decode of 10 M and 100 M-sample WAV captures (/usr/bin/time -v: CPU time, peak RSS);
+#   scenes per sample: default (float, fixed, fixed without metrics) and minimal (summary.json samples_simulated);
 #   simulate --jobs 1 against --jobs 2 (wall time: the only clock that shows a parallel speedup);
 #   and the ratios. Rates are per second of CPU time (one core), so a busy machine does not
 #   scale them down. BENCH_DECODE_SAMPLES="1e7 1e8" sets the decode lengths (disk: 4 bytes/sample).
@@ -58,6 +59,23 @@ for j in 1 2; do
     --set geometry.repeats=20 --out "$T/jobs$j" --quiet --jobs $j >/dev/null
 done
 if cmp -s "$T/jobs1/measurements.csv" "$T/jobs2/measurements.csv"; then echo same; else echo DIFFERENT; fi >"$T/jobs.same"
+# Scenes per sample (only the stages and metrics each names): CPU seconds of a long run minus a
+# 1-repeat run over the samples between them (summary.json samples_simulated), so the one-off
+# design and calibration do not count.
+scene_run() {  # NAME SCENE REPEATS [ARGS...]
+  local name=$1 scene=$2 reps=$3
+  shift 3
+  for r in 1 "$reps"; do
+    /usr/bin/time -f "%U %S" -o "$T/scene.time" "$B"/tool/ranging simulate "$scene" --set geometry.repeats=$r \
+      --out "$T/scene" --quiet "$@" >/dev/null
+    echo "$name $r $(cat "$T/scene.time") $($PY -c 'import json,sys; print(json.load(open(sys.argv[1]))["samples_simulated"])' "$T/scene/summary.json")"
+  done >>"$T/scenes.txt"
+}
+: >"$T/scenes.txt"
+scene_run default scenes/default.yaml 40
+scene_run default-fixed scenes/default.yaml 40 --precision fixed
+scene_run default-fixed-no-metrics scenes/default.yaml 40 --precision fixed --set 'receiver.metrics=[]'
+scene_run minimal scenes/minimal.yaml 400
 $PY - "$T" <<'PYEOF'
 import json, re, sys
 t = sys.argv[1]
@@ -108,6 +126,19 @@ for j in (1, 2):
     print(f"  --jobs {j}: wall {w[j][0]:.2f} s, CPU {w[j][1] + w[j][2]:.2f} s")
 print(f"  speedup (wall, jobs 1 / jobs 2): {w[1][0] / w[2][0]:.2f}; measurements.csv "
       f"{open(f'{t}/jobs.same').read().strip()} (target >= 1.8 on 2 idle cores)")
+print()
+print("Scenes, per received sample (simulate; CPU of a long run minus a 1-repeat run, over the samples between):")
+sc = {}
+for line in open(f"{t}/scenes.txt"):
+    name, r, u, sy, n = line.split()
+    sc.setdefault(name, {})[int(r)] = (float(u) + float(sy), int(n))
+ns = {}
+for name, v in sc.items():
+    (c1, n1), (cr, nr) = v[1], max(v.items())[1]
+    ns[name] = (cr - c1) / (nr - n1) * 1e9
+    print(f"  {name:26s} {ns[name]:8.1f} ns/sample {1e3 / ns[name]:8.1f} MS/s {1e3 / ns[name] / 5:8.1f} x real time")
+print(f"  default / minimal per sample: {ns['default'] / ns['minimal']:.2f} (target >= 5); fixed precision, "
+      f"metrics [] / all: {ns['default-fixed-no-metrics'] / ns['default-fixed']:.2f}")
 print()
 print("Verilator RTL (tb/bench_receiver_top):")
 for line in open(f"{t}/rtl.txt"):

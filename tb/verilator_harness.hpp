@@ -92,8 +92,20 @@ class Harness {
   }
 
   void settle() { top_->eval(); }
-  // One clock cycle: rising edge (registers update), then falling edge.
+  // One clock cycle: rising edge (registers update), then falling edge. Without a trace the
+  // inputs set since the last eval settle in the rising edge's own eval (Verilator 5 runs the
+  // input-combinational region before the clocked one), so two evals; with a trace a third
+  // first, to dump the pre-edge values at their own time step.
   void tick() {
+    if (!tracing()) {
+      top_->clk = 1;
+      top_->eval();
+      top_->clk = 0;
+      top_->eval();
+      time_ += 10;  // the same time base as the traced path (a trace opened later continues it)
+      ++cycles_;
+      return;
+    }
     top_->eval();
     dump();
     top_->clk = 1;
