@@ -186,6 +186,10 @@ std::vector<Case> catalogue() {
       {"scene: empty references folder",
        {{"s.yaml", kScene + "receiver:\n  reference: files\n  references_dir: refs\n"}, {"refs", kDir}}, sim,
        {"refs: no reference for code 1", "Gold4-1.csv or .wav"}},
+      {"scene: unknown metric", {{"s.yaml", kScene + "receiver:\n  metrics: [pearson, rho]\n"}}, sim,
+       {"s.yaml:5: receiver.metrics", "metrics[1]: 'rho' is not valid; valid: pearson, energy, td"}},
+      {"evaluate: a scene that computes no metric", {{"s.yaml", kScene + "receiver:\n  metrics: []\n"}},
+       "evaluate {d}/s.yaml --quiet --no-plots --out {d}/ev", {"s.yaml: receiver.metrics", "[pearson, energy, td]"}},
       // --- outputs ---
       {"simulate --out is a file", {{"s.yaml", kScene}, {"out", "precious\n"}}, sim,
        {"option --out", "'{d}/out' exists and is not a folder"}},
