@@ -254,6 +254,44 @@ module tof_distance #(
       default: ;
     endcase
   end
+
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh tof_distance). Assumed: reset first. Every input
+  // else is free: any burst schedule, arrival, code (in range or not), c write and m_ready.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  // Clocks spent on one event (BACK .. CLAMP), and the bound it must stay under: CODES-1
+  // step-backs of a period, a ToF loop of at most 2^TIME_W / CYCLE + 2 cycles stepped back
+  // plus the counter-wrap corrections (two clocks each), TOF_W multiply steps, the clamp.
+  localparam integer F_BOUND = CODES + 2 * ((1 << TIME_W) / CYCLE + 6) + TOF_W + 4;
+  reg [7:0] f_busy = 8'd0;
+  always @(posedge clk)
+    if (rst || state == IDLE || state == OUT) f_busy <= 8'd0;
+    else if (f_busy != 8'hff) f_busy <= f_busy + 8'd1;
+  always @(posedge clk)
+    if (f_past_valid && $past(rst))
+      assert(state == IDLE && !have_burst && c_current == C_INIT && !in_back && f_busy == 0);
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(state <= TOF0);                       // the seven legal states
+      assert(in_back == (state == BACK));
+      assert(f_busy <= F_BOUND);                   // every event ends: no stall in TOF / TOF0
+      if (state == MUL) assert(cnt < TOF_W);
+      if (m_valid) begin
+        assert(!s_ready);
+        // no burst of the code before the arrival: ToF and distance 0, not saturated
+        if (m_flags[0]) assert(m_tof == 0 && m_distance == 0 && !m_flags[1]);
+      end
+    end
+  // output stream: held with its data until taken
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && !rst && $past(m_valid && !m_ready)) begin
+      assert(m_valid);
+      assert($stable(m_code) && $stable(m_flags) && $stable(m_tof) && $stable(m_distance));
+      assert($stable(m_score) && $stable(m_margin));
+    end
+`endif
 endmodule
 
 `default_nettype wire
