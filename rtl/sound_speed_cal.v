@@ -96,6 +96,46 @@ module sound_speed_cal #(
       end
     end
   end
+
+`ifdef FORMAL
+  // Formal properties (formal/run_formal.sh sound_speed_cal). Assumed: reset first; every input
+  // else is free (arm, measurements, flags, ToF). The division is checked against the
+  // equation with a shadow of the ToF the run started with.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  reg [TOF_W-1:0] f_tof;
+  always @(posedge clk)
+    if (!rst && !running && armed && meas_valid && meas_flags == 2'b00 && meas_tof != 0) f_tof <= meas_tof;
+  wire [NW-1:0] f_num0 = D_SHIFTED + (f_tof >> 1);           // D 2^SH + floor(ToF / 2)
+  wire [NW-1:0] f_quot = f_num0 / f_tof;                      // the equation's C before saturation
+  wire f_over = |(f_quot >> C_W);
+  wire [C_W-1:0] f_c = f_over ? {C_W{1'b1}} : f_quot[C_W-1:0];
+  // restoring division after cnt steps: the top cnt numerator bits consumed, quotient q in
+  // num's low cnt bits, the rest of the numerator above it, and top = q den + rem, rem < den
+  wire [NW-1:0] f_mask = ({{(NW-1){1'b0}}, 1'b1} << cnt) - 1'b1;
+  wire [NW-1:0] f_top = f_num0 >> (NW - cnt);
+  /* verilator lint_off UNUSEDSIGNAL */
+  wire [NW+TOF_W-1:0] f_qd = (num & f_mask) * den + rem;
+  /* verilator lint_on UNUSEDSIGNAL */
+  always @(posedge clk)
+    if (f_past_valid && $past(rst)) assert(!armed && !running && !c_wr && sat_count == 0);
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(busy == running);
+      if (running) begin
+        assert(cnt < NW && den == f_tof && den != 0 && rem < den);
+        assert(f_qd == {{TOF_W{1'b0}}, f_top});
+        assert((num >> cnt) == (f_num0 & ~(f_mask << (NW - cnt)) & ({NW{1'b1}} >> cnt)));
+      end
+    end
+  always @(posedge clk)
+    if (f_past_valid && !$past(rst) && !rst) begin
+      if (c_wr) assert(c_value == f_c && $past(running) && !$past(c_wr));  // C by the equation, one clock
+      if (c_wr && f_over) assert(sat_count == ($past(sat_count) == 8'hff ? 8'hff : $past(sat_count) + 8'd1));
+      if (c_wr && !f_over || !c_wr) assert(sat_count == $past(sat_count));
+    end
+`endif
 endmodule
 
 `default_nettype wire
