@@ -9,10 +9,13 @@
 #    output-stream assertion (m_valid held until m_ready) fails in BMC.
 #  - abc: the mutant bandpass_sos (shared) runs its schedule while an output waits
 #    (`run = !park`): the next sample overwrites m_data, the output-stream assertion fails.
-# Exit 0 when all three mutants are caught, 1 when one slips through, 2 on a tool error.
+#  - abc: the mutant tof_distance leaves OUT without m_ready: m_valid held fails.
+#  - abc: the mutant sound_speed_cal drops the rounding term floor(ToF / 2) from its numerator:
+#    the division's invariant against the equation fails.
+# Exit 0 when all five mutants are caught, 1 when one slips through, 2 on a tool error.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-case "${1:-}" in -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
+case "${1:-}" in -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
 work=$(mktemp -d "${TMPDIR:-/tmp}/ranging-mutant-XXXXXX")
 trap 'rm -rf "$work"' EXIT
 cp "$root"/rtl/*.v "$work/"
@@ -55,4 +58,10 @@ caught_at peak_detector peak_detector.v "$(line_of peak_detector.v 'assert(m_val
 # the filter's schedule no longer freezes while its output waits for m_ready
 mutate bandpass_sos.v 's/  wire                  run = !(out_valid \&\& !m_ready) \&\& !park;/  wire                  run = !park;/'
 caught_at bandpass_sos bandpass_sos.v "$(line_of bandpass_sos.v 'assert(m_data == $past(m_data)')" "the overwritten output"
+# the measurement leaves before the UART took it
+mutate tof_distance.v 's/        OUT: if (m_ready) state <= IDLE;/        OUT: state <= IDLE;/'
+caught_at tof_distance tof_distance.v "$(line_of tof_distance.v 'assert(m_valid);')" "the dropped measurement"
+# C without its rounding term
+mutate sound_speed_cal.v 's/        num <= D_SHIFTED + (meas_tof >> 1);/        num <= D_SHIFTED;/'
+caught_at sound_speed_cal sound_speed_cal.v "$(line_of sound_speed_cal.v 'assert((num >> cnt)')" "the unrounded C"
 exit 0
