@@ -192,6 +192,53 @@ double BandpassFloat::execute(double x) {
   return x;
 }
 
+namespace {
+
+// y = b0 x + b1 x1 + b2 x2 - a1 y1 - a2 y2, left to right: execute()'s expression exactly.
+template <int S>
+void float_kernel(const double* in, double* out, std::size_t len, const std::vector<Biquad>& c,
+                  std::vector<BandpassFloat::State>& st) {
+  double b0[S], b1[S], b2[S], a1[S], a2[S], x1[S], x2[S], y1[S], y2[S];
+  for (int k = 0; k < S; ++k) {
+    b0[k] = c[k].b0, b1[k] = c[k].b1, b2[k] = c[k].b2, a1[k] = c[k].a1, a2[k] = c[k].a2;
+    x1[k] = st[k].x1, x2[k] = st[k].x2, y1[k] = st[k].y1, y2[k] = st[k].y2;
+  }
+  for (std::size_t i = 0; i < len; ++i) {
+    double x = in[i];
+    for (int k = 0; k < S; ++k) {
+      const double y = b0[k] * x + b1[k] * x1[k] + b2[k] * x2[k] - a1[k] * y1[k] - a2[k] * y2[k];
+      x2[k] = x1[k];
+      x1[k] = x;
+      y2[k] = y1[k];
+      y1[k] = y;
+      x = y;
+    }
+    out[i] = x;
+  }
+  for (int k = 0; k < S; ++k) st[k] = {x1[k], x2[k], y1[k], y2[k]};
+}
+
+}  // namespace
+
+void BandpassFloat::execute_block(std::span<const double> in, std::span<double> out) {
+  if (in.size() != out.size()) throw InputError("BandpassFloat::execute_block: input and output sizes differ");
+  if (in.empty()) return;
+  switch (sections_.size()) {
+    case 1: float_kernel<1>(in.data(), out.data(), in.size(), sections_, state_); break;
+    case 2: float_kernel<2>(in.data(), out.data(), in.size(), sections_, state_); break;
+    case 3: float_kernel<3>(in.data(), out.data(), in.size(), sections_, state_); break;
+    case 4: float_kernel<4>(in.data(), out.data(), in.size(), sections_, state_); break;
+    case 5: float_kernel<5>(in.data(), out.data(), in.size(), sections_, state_); break;
+    case 6: float_kernel<6>(in.data(), out.data(), in.size(), sections_, state_); break;
+    case 7: float_kernel<7>(in.data(), out.data(), in.size(), sections_, state_); break;
+    case 8: float_kernel<8>(in.data(), out.data(), in.size(), sections_, state_); break;
+    default:
+      for (std::size_t i = 0; i < in.size(); ++i) out[i] = execute(in[i]);
+      return;
+  }
+  for (std::size_t k = 0; k < sections_.size(); ++k) out_[k] = state_[k].y1;  // the last sample's
+}
+
 // ---- bit-accurate fixed point --------------------------------------------------------------
 
 BandpassFixed::BandpassFixed(const SosFilter& filter, const BandpassFixedConfig& config)

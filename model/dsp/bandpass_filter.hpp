@@ -83,12 +83,18 @@ class BandpassFloat final : public BandpassFilter {
   explicit BandpassFloat(const SosFilter& filter);  // throws InputError if no sections
   void reset() override;
   double execute(double x) override;
+  // Block form: out[i] = execute(in[i]) for every i, bit for bit (the same expression per
+  // section, in the same order; section_outputs() then holds the last sample's). The state
+  // lives in locals for the block (specialized for 1..8 sections), so the out-of-order core
+  // overlaps the sections' recursions. Sizes must match (InputError); in and out may alias.
+  void execute_block(std::span<const double> in, std::span<double> out);
   const std::vector<double>& section_outputs() const { return out_; }
 
- private:
   struct State {
     double x1 = 0, x2 = 0, y1 = 0, y2 = 0;
   };
+
+ private:
   std::vector<Biquad> sections_;
   std::vector<State> state_;
   std::vector<double> out_;

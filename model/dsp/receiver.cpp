@@ -246,6 +246,28 @@ std::optional<Event> ReceiverFloat::execute(double x) {
   return detector_.execute(bank_);
 }
 
+std::size_t ReceiverFloat::execute_block(std::span<const double> x, std::vector<Event>& events,
+                                        std::span<double> filtered) {
+  if (!filtered.empty() && filtered.size() != x.size()) {
+    throw InputError("ReceiverFloat::execute_block: filtered output size differs from the input's");
+  }
+  constexpr std::size_t kChunk = 4096;
+  double y[kChunk];
+  const std::size_t before = events.size();
+  for (std::size_t n0 = 0; n0 < x.size(); n0 += kChunk) {
+    const std::size_t len = std::min(kChunk, x.size() - n0);
+    filter_.execute_block(x.subspan(n0, len), std::span<double>(y, len));
+    for (std::size_t i = 0; i < len; ++i) {
+      if (bank_.execute(y[i])) {
+        if (auto e = detector_.execute(bank_)) events.push_back(*e);
+      }
+    }
+    if (!filtered.empty()) std::copy(y, y + len, filtered.begin() + static_cast<std::ptrdiff_t>(n0));
+    filtered_ = y[len - 1];
+  }
+  return events.size() - before;
+}
+
 ReceiverFixed::ReceiverFixed(const ReceiverDesign& d)
     : input_bits_(d.config.bandpass.input_bits),
       frac_bits_(d.config.detector.frac_bits),

@@ -103,6 +103,11 @@ class ReceiverFloat {
   explicit ReceiverFloat(const ReceiverDesign& design);
   void reset();
   std::optional<Event> execute(double x);
+  // Block form: execute() on every x[i] in order, bit for bit (events, state, filtered()); the
+  // bandpass runs a chunk at a time (BandpassFloat::execute_block), then the bank and the
+  // detector per sample. Events are appended (returns how many); filtered, when not empty
+  // (its size must be x's, else InputError), receives every bandpass output.
+  std::size_t execute_block(std::span<const double> x, std::vector<Event>& events, std::span<double> filtered = {});
   std::optional<Event> flush() { return detector_.flush(); }
   double filtered() const { return filtered_; }  // last bandpass output
   const CorrelatorBankFloat& bank() const { return bank_; }

@@ -265,9 +265,15 @@ struct SceneSimulator::Link {
     const double inv = 1.0 / scale;
     ReceiverFloat rf(design);
     const bool keep = scene->receiver.metrics.any();  // the filtered stream feeds the metrics only
-    for (std::size_t n = 0; n < volts.size(); ++n) {
-      if (auto e = rf.execute(volts[n] * inv)) ev.push_back(*e);
-      if (keep) filtered[n] = rf.filtered() * scale;
+    // ReceiverFloat::execute_block (bit for bit execute() per sample), a chunk at a time
+    constexpr std::size_t kChunk = 4096;
+    std::vector<double> xs(std::min(kChunk, volts.size()));
+    for (std::size_t n0 = 0; n0 < volts.size(); n0 += kChunk) {
+      const std::size_t len = std::min(kChunk, volts.size() - n0);
+      for (std::size_t i = 0; i < len; ++i) xs[i] = volts[n0 + i] * inv;
+      std::span<double> f = keep ? std::span<double>(filtered.data() + n0, len) : std::span<double>();
+      rf.execute_block(std::span<const double>(xs.data(), len), ev, f);
+      for (double& v : f) v *= scale;
     }
     if (auto e = rf.flush()) ev.push_back(*e);
     return ev;
@@ -315,9 +321,8 @@ struct SceneSimulator::Link {
     if (!fixed()) {
       ReceiverFloat rf(design);
       for (std::size_t k; (k = src.read(x)) > 0;) {
-        for (std::size_t i = 0; i < k; ++i) {
-          if (auto e = rf.execute(x[i] * inv)) ev.push_back(*e);
-        }
+        for (std::size_t i = 0; i < k; ++i) x[i] *= inv;
+        rf.execute_block(std::span<const double>(x.data(), k), ev);
       }
       if (auto e = rf.flush()) ev.push_back(*e);
     } else {
