@@ -10,6 +10,8 @@
 #include <numbers>
 
 #include "model/base/error.hpp"
+#include "model/config/receiver_config.hpp"
+#include "model/hw/realtime.hpp"
 #include "model/sim/channel.hpp"
 #include "model/sim/moving_channel.hpp"
 #include "model/sim/rotor.hpp"
@@ -314,4 +316,41 @@ TEST(RotorDoppler, ConstantLineOfSightSpeed) {
   const DopplerPoint moving = doppler_point(sim, 0.5, 17.0, 1);
   EXPECT_NEAR(moving.doppler, (340.0 + 17.0) / 340.0, 1e-9);
   EXPECT_EQ(moving.bursts, moving.decoded + moving.misdecoded + moving.missed);
+}
+
+TEST(RotorDoppler, TwoCyclesPerChipRemedyDoublesTheTolerance) {
+  // The remedy of docs/results/blade-crossing.md, section 6: configs/doppler-q2.yaml (2 carrier
+  // cycles per chip, decimation 25) decodes every burst at 6 m/s line-of-sight speed, where the
+  // 4-cycle default decodes none; its bank stays real time at 30 MHz, and the 10-decimation
+  // alternative is not.
+  const std::string src = RANGING_SOURCE_DIR;
+  const std::string link =
+      "medium: {speed_of_sound: 340}\ntransducers: {sensitivity: 0.165}\ngeometry: {distances_m: [0.5]}\n"
+      "noise: {noise_v: 0.005, seed: 7, adc: {bits: 12, full_scale_v: 5.0}}\n";
+  Scene q2 = parse_scene(link + "excitation: {family: M1, cycles_per_chip: 2, schedule: {mode: periodic, "
+                                "period_s: 0.00042}}\nreceiver: {precision: fixed, config: " +
+                             src + "/configs/doppler-q2.yaml}\n",
+                         "q2.yaml");
+  Scene q4 = parse_scene(link + "excitation: {family: M1, schedule: {mode: periodic, period_s: 0.00042}}\n"
+                                "receiver: {precision: fixed}\n",
+                         "q4.yaml");
+  SceneSimulator sim2(q2), sim4(q4);
+  const DopplerPoint fast2 = doppler_point(sim2, 0.5, 6.0, 2);
+  const DopplerPoint fast4 = doppler_point(sim4, 0.5, 6.0, 2);
+  EXPECT_EQ(fast2.bursts, 14);
+  EXPECT_EQ(fast2.decoded, fast2.bursts);
+  EXPECT_LT(std::abs(fast2.bias_centre_m), 1e-3);
+  EXPECT_EQ(fast4.bursts, 14);
+  EXPECT_LT(fast4.decoded, fast4.bursts / 2);
+  // Beyond the doubled tolerance the remedy fails too: the limit is real, not a broken check.
+  const DopplerPoint faster2 = doppler_point(sim2, 0.5, 12.0, 2);
+  EXPECT_LT(faster2.decoded, faster2.bursts);
+
+  const auto cfg = load_receiver_config(src + "/configs/doppler-q2.yaml");
+  EXPECT_EQ(cfg.cycles_per_chip, 2);
+  const RealTimeBudget rt = realtime_budget(design_receiver(cfg));
+  EXPECT_TRUE(rt.real_time) << rt.summary();
+  const RealTimeBudget rt10 = realtime_budget(design_receiver(load_receiver_config(
+      src + "/configs/doppler-q2.yaml", Overrides{{"correlator.decimation", "10"}})));
+  EXPECT_FALSE(rt10.real_time) << rt10.summary();
 }
