@@ -85,6 +85,30 @@ TEST(Verify, AConfigurationThatIsNotCommittedMatchesTheModelAtEveryStage) {
   EXPECT_TRUE(fs::exists(scratch() / "ok/ip/files.f"));
 }
 
+TEST(Verify, TheDopplerRemedyConfigurationMatchesTheModelAndIsRealTime) {
+  // configs/doppler-q2.yaml (docs/results/blade-crossing.md, section 6): 50 samples per chip,
+  // decimation 25, a 14-tap chip template (2 per chip); the RTL equals the model and keeps 6 clocks per sample.
+  const auto r = run_tool("verify --config " + (kRoot / "configs/doppler-q2.yaml").string() + " --out " +
+                          (scratch() / "q2").string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["config"], "doppler-q2");
+  EXPECT_TRUE(j["pass"].get<bool>());
+  for (const auto& s : j["stages"]) {
+    EXPECT_GT(s["compared"].get<long>(), 0) << s["name"];
+    EXPECT_EQ(s["mismatches"].get<long>(), 0) << s["name"];
+  }
+  EXPECT_TRUE(j["realtime"]["rule_real_time"].get<bool>()) << j["realtime"]["rule"];
+  EXPECT_TRUE(j["realtime"]["rtl_real_time"].get<bool>());
+  EXPECT_EQ(j["realtime"]["late_samples"].get<long>(), 0);
+  // Each coded stream decodes every code of the family (Gold4: 9).
+  for (const auto& run : j["runs"]) {
+    if (run["name"].get<std::string>().rfind("coded-", 0) == 0) {
+      EXPECT_EQ(run["events"].get<int>(), 9) << run["name"];
+    }
+  }
+}
+
 TEST(Verify, AFlippedOperatorInTheCombinerFailsOnTheCombinerStage) {
   const fs::path mine = scratch() / "myrtl";
   fs::create_directories(mine);
