@@ -146,24 +146,32 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     den[k] = var;
     den_max = std::max(den_max, var);
   }
+  // Per lag, once for every template: sqrt(var) (0 where the window is flat: rho = 0 there).
+  std::vector<double> sd(lags);
+  for (std::size_t k = 0; k < lags; ++k) sd[k] = den[k] > 1e-24 * den_max && den[k] > 0 ? std::sqrt(den[k]) : 0.0;
   std::fill(p.in, p.in + nfft, 0.0);
   for (std::size_t i = 0; i < w; ++i) p.in[i] = xw[i] - mean;
   fftw_execute(p.fwd);
   const std::size_t nc = nfft / 2 + 1;
+  // 1/nfft is a power of two: x * inv_nfft is x / nfft exactly.
+  const double inv_nfft = 1.0 / static_cast<double>(nfft);
   std::vector<LagRho> out;
   for (std::size_t j = 0; j < t_.size(); ++j) {
+    // The spectrum product written out: (a + ib)(c + id) = (ac - bd) + i(ad + bc), the
+    // expressions std::complex's multiplication computes for finite operands, without its
+    // NaN recovery branch (both spectra are finite: FFTs of finite data).
+    const std::complex<double>* ts = p.tspec[j].data();
     for (std::size_t i = 0; i < nc; ++i) {
-      const std::complex<double> v = std::complex<double>(p.spec[i][0], p.spec[i][1]) * p.tspec[j][i];
-      p.prod[i][0] = v.real();
-      p.prod[i][1] = v.imag();
+      const double ar = p.spec[i][0], ai = p.spec[i][1], br = ts[i].real(), bi = ts[i].imag();
+      p.prod[i][0] = ar * br - ai * bi;
+      p.prod[i][1] = ar * bi + ai * br;
     }
     fftw_execute(p.inv);  // unnormalized: out = nfft * correlation
     LagRho best{-2.0, a};
+    const double tn = tnorm_[j];
     for (std::size_t k = 0; k < lags; ++k) {
       double r = 0;
-      if (den[k] > 1e-24 * den_max && den[k] > 0 && tnorm_[j] > 0) {
-        r = std::clamp(p.out[k] / static_cast<double>(nfft) / (std::sqrt(den[k]) * tnorm_[j]), -1.0, 1.0);
-      }
+      if (sd[k] > 0 && tn > 0) r = std::clamp(p.out[k] * inv_nfft / (sd[k] * tn), -1.0, 1.0);
       if (r > best.rho) best = {r, a + static_cast<long>(k)};
     }
     out.push_back(best);

@@ -302,7 +302,8 @@ struct SceneSimulator::Link {
       }
       rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
       if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only
-        for (std::size_t n = n0; n < n1; ++n) filtered[n] = bp.execute(volts[n]);
+        bp.execute_block(std::span<const double>(volts.data() + n0, n1 - n0),
+                         std::span<double>(filtered.data() + n0, n1 - n0));
       }
     }
     for (const auto& e : raw_events) ev.push_back(rx.to_float(e));
@@ -949,7 +950,17 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
   const bool fixed = lk.fixed();
   src.rewind();
   for (std::size_t k; (k = src.read(x)) > 0;) {
-    for (std::size_t i = 0; i < k; ++i) w.push_back(fixed ? bp.execute(x[i]) : bp.execute(x[i] * inv) * scale);
+    // The block form (bit for bit execute() per sample); scaled as receive() scales.
+    const std::size_t w0 = w.size();
+    w.resize(w0 + k);
+    const std::span<double> wk(w.data() + w0, k);
+    if (fixed) {
+      bp.execute_block(std::span<const double>(x.data(), k), wk);
+    } else {
+      for (std::size_t i = 0; i < k; ++i) wk[i] = x[i] * inv;
+      bp.execute_block(wk, wk);
+      for (double& v : wk) v *= scale;
+    }
     const long avail = base + static_cast<long>(w.size());
     while (next < order.size() && needs[order[next]].lo < avail) active.push_back(order[next++]);
     std::erase_if(active, [&](std::size_t i) {
