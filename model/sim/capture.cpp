@@ -343,13 +343,32 @@ double wav_sample(const char* p, const WavLayout& w, const std::string& origin, 
   return s / 8388608.0;
 }
 
+void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const std::string& origin, std::size_t i0,
+                 double* out) {
+  const std::size_t f = w.frame;
+  const auto* u = reinterpret_cast<const unsigned char*>(p);
+  if (w.flt) {
+    for (std::size_t k = 0; k < frames; ++k) out[k] = wav_sample(p + k * f, w, origin, i0 + k);
+  } else if (w.bits == 16) {
+    for (std::size_t k = 0; k < frames; ++k, u += f) {
+      out[k] = static_cast<std::int16_t>(static_cast<std::uint16_t>(u[0] | (u[1] << 8))) / 32768.0;
+    }
+  } else {
+    for (std::size_t k = 0; k < frames; ++k, u += f) {
+      std::int32_t s = static_cast<std::int32_t>(u[0] | (u[1] << 8) | (u[2] << 16));
+      if (s & 0x800000) s -= 0x1000000;
+      out[k] = s / 8388608.0;
+    }
+  }
+}
+
 Capture parse_capture_wav(const std::string& b, const std::string& origin) {
   const WavLayout w = parse_wav_layout([&](std::size_t at, std::size_t len) { return b.substr(at, len); }, b.size(),
                                        origin);
   Capture c;
   c.sample_rate = w.rate;
   c.samples.resize(w.n);
-  for (std::size_t i = 0; i < w.n; ++i) c.samples[i] = wav_sample(b.data() + w.body + i * w.frame, w, origin, i);
+  wav_samples(b.data() + w.body, w.n, w, origin, 0, c.samples.data());
   if (w.n < 2) fail_wav(origin, w.chunk_at, "the data chunk holds fewer than two samples");
   return c;
 }

@@ -115,7 +115,7 @@ std::size_t CaptureSource::read(std::span<double> out) {
     if (static_cast<std::size_t>(in_.gcount()) != buf_.size()) {
       throw InputError(path_ + ": changed while it was read (shorter than its data chunk)");
     }
-    for (std::size_t i = 0; i < frames; ++i) out[k + i] = wav_sample(buf_.data() + i * wav_.frame, wav_, path_, pos_ + i);
+    wav_samples(buf_.data(), frames, wav_, path_, pos_, out.data() + k);
     k += frames;
     pos_ += frames;
   }

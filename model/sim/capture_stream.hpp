@@ -61,6 +61,10 @@ WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::siz
                            const std::string& origin);
 // Frame i at p (its first channel): full-scale fraction (PCM) or the float value; InputError on NaN/Inf.
 double wav_sample(const char* p, const WavLayout& w, const std::string& origin, std::size_t i);
+// frames consecutive frames from p (frame i0 first) into out: out[k] = wav_sample(frame i0 + k),
+// with the format's branch taken once per block.
+void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const std::string& origin, std::size_t i0,
+                 double* out);
 
 // The sidecar STEM.json of path (if any) fills what meta lacks (read_capture's rule).
 void merge_capture_sidecar(CaptureMeta& meta, const std::string& path);
