@@ -323,32 +323,22 @@ WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::siz
   }
 }
 
-double wav_sample(const char* p, const WavLayout& w, const std::string& origin, std::size_t i) {
-  if (w.flt) {
-    std::uint32_t u = 0;
-    for (int k = 3; k >= 0; --k) u = (u << 8) | static_cast<unsigned char>(p[k]);
-    float f;
-    std::memcpy(&f, &u, sizeof f);
-    if (!std::isfinite(f)) fail_wav(origin, w.body + i * w.frame, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
-    return f;
-  }
-  if (w.bits == 16) {
-    return static_cast<std::int16_t>(static_cast<std::uint16_t>(static_cast<unsigned char>(p[0]) |
-                                                                (static_cast<unsigned char>(p[1]) << 8))) /
-           32768.0;
-  }
-  std::int32_t s = static_cast<std::int32_t>(static_cast<unsigned char>(p[0]) | (static_cast<unsigned char>(p[1]) << 8) |
-                                             (static_cast<unsigned char>(p[2]) << 16));
-  if (s & 0x800000) s -= 0x1000000;
-  return s / 8388608.0;
-}
-
 void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const std::string& origin, std::size_t i0,
                  double* out) {
   const std::size_t f = w.frame;
   const auto* u = reinterpret_cast<const unsigned char*>(p);
   if (w.flt) {
-    for (std::size_t k = 0; k < frames; ++k) out[k] = wav_sample(p + k * f, w, origin, i0 + k);
+    for (std::size_t k = 0; k < frames; ++k, u += f) {
+      const std::uint32_t bits = static_cast<std::uint32_t>(u[0]) | (static_cast<std::uint32_t>(u[1]) << 8) |
+                                 (static_cast<std::uint32_t>(u[2]) << 16) | (static_cast<std::uint32_t>(u[3]) << 24);
+      float x;
+      std::memcpy(&x, &bits, sizeof x);
+      if (!std::isfinite(x)) {
+        const std::size_t i = i0 + k;
+        fail_wav(origin, w.body + i * w.frame, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
+      }
+      out[k] = x;
+    }
   } else if (w.bits == 16) {
     for (std::size_t k = 0; k < frames; ++k, u += f) {
       out[k] = static_cast<std::int16_t>(static_cast<std::uint16_t>(u[0] | (u[1] << 8))) / 32768.0;

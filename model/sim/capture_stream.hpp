@@ -12,7 +12,7 @@
 //   CsvCaptureScan  the CSV line grammar, row by row (header lines, metadata keys, strict numbers,
 //                   increasing time), then finish() (Record Length, row count, sample rate) and
 //                   check_grid() per row;
-//   parse_wav_layout / wav_sample  the RIFF chunk walk and one sample's decoding.
+//   parse_wav_layout / wav_samples the RIFF chunk walk and the samples' decoding.
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
@@ -59,10 +59,9 @@ struct WavLayout {
 // bytes(at, len): len bytes of the file from offset at (fewer at its end).
 WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::size_t)>& bytes, std::size_t file_size,
                            const std::string& origin);
-// Frame i at p (its first channel): full-scale fraction (PCM) or the float value; InputError on NaN/Inf.
-double wav_sample(const char* p, const WavLayout& w, const std::string& origin, std::size_t i);
-// frames consecutive frames from p (frame i0 first) into out: out[k] = wav_sample(frame i0 + k),
-// with the format's branch taken once per block.
+// frames consecutive frames from p (frame i0 first) into out, each its first channel as a
+// full-scale fraction (PCM) or the float value, the format's branch taken once per block;
+// InputError naming the frame on NaN/Inf.
 void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const std::string& origin, std::size_t i0,
                  double* out);
 

@@ -146,9 +146,8 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     den[k] = var;
     den_max = std::max(den_max, var);
   }
-  // Per lag, once for every template: sqrt(var) (0 where the window is flat: rho = 0 there).
-  std::vector<double> sd(lags);
-  for (std::size_t k = 0; k < lags; ++k) sd[k] = den[k] > 1e-24 * den_max && den[k] > 0 ? std::sqrt(den[k]) : 0.0;
+  // Per lag, once for every template: den becomes sqrt(var) (0 where the window is flat: rho = 0 there).
+  for (double& d : den) d = d > 1e-24 * den_max && d > 0 ? std::sqrt(d) : 0.0;
   std::fill(p.in, p.in + nfft, 0.0);
   for (std::size_t i = 0; i < w; ++i) p.in[i] = xw[i] - mean;
   fftw_execute(p.fwd);
@@ -171,7 +170,7 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     const double tn = tnorm_[j];
     for (std::size_t k = 0; k < lags; ++k) {
       double r = 0;
-      if (sd[k] > 0 && tn > 0) r = std::clamp(p.out[k] * inv_nfft / (sd[k] * tn), -1.0, 1.0);
+      if (den[k] > 0 && tn > 0) r = std::clamp(p.out[k] * inv_nfft / (den[k] * tn), -1.0, 1.0);
       if (r > best.rho) best = {r, a + static_cast<long>(k)};
     }
     out.push_back(best);
