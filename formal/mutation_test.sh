@@ -12,10 +12,13 @@
 #  - abc: the mutant tof_distance leaves OUT without m_ready: m_valid held fails.
 #  - abc: the mutant sound_speed_cal drops the rounding term floor(ToF / 2) from its numerator:
 #    the division's invariant against the equation fails.
-# Exit 0 when all five mutants are caught, 1 when one slips through, 2 on a tool error.
+#  - abc, the system proof: the mutant ranging_system puts the ADC's sticky overrun flag straight
+#    into the frame's flags byte: measurement_uart's input rule (fields stable while waiting),
+#    asserted of its driver in the composition, fails.
+# Exit 0 when all six mutants are caught, 1 when one slips through, 2 on a tool error.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-case "${1:-}" in -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
+case "${1:-}" in -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;; esac
 work=$(mktemp -d "${TMPDIR:-/tmp}/ranging-mutant-XXXXXX")
 trap 'rm -rf "$work"' EXIT
 cp "$root"/rtl/*.v "$work/"
@@ -64,4 +67,11 @@ caught_at tof_distance tof_distance.v "$(line_of tof_distance.v 'assert(m_valid)
 # C without its rounding term
 mutate sound_speed_cal.v 's/        num <= D_SHIFTED + (meas_tof >> 1);/        num <= D_SHIFTED;/'
 caught_at sound_speed_cal sound_speed_cal.v "$(line_of sound_speed_cal.v 'assert((num >> cnt)')" "the unrounded C"
+# the system: the ADC's sticky overrun flag straight into the frame's flags (it may rise while a
+# measurement waits for the UART): measurement_uart's input rule, asserted of its driver, fails
+# (the other mutants undone first: the system job reads tof_distance.v and measurement_uart.v)
+cp "$root"/rtl/*.v "$work/"
+mutate ranging_system.v "s/    .s_flags({5'd0, frame_error, m_flags}),/    .s_flags({5'd0, led_error, m_flags}),/"
+caught_at ranging_system measurement_uart.v "$(line_of measurement_uart.v 'assume({s_code, s_flags')" \
+  "the overrun flag changing under a waiting measurement"
 exit 0

@@ -9,12 +9,15 @@
 # name); 2: usage or tool error.
 #
 # Usage: formal/run_formal.sh JOB [--rtl DIR] [--out DIR] [--depth N] [--bmc-only]
-#   JOB is formal/JOB.job: lines `top MODULE`, `files a.v b.v` (relative to the RTL folder),
+#   JOB is formal/JOB.job: lines `top MODULE`, `files a.v b.v` (relative to the RTL folder;
+#   formal/x.v: an environment model in formal/),
 #   `chparam NAME VALUE` (parameters for the proof), `define NAME` (a Verilog define),
-#   `engine smtbmc|abc`, `induction yes|no` (the unbounded proof), `depth N`.
+#   `engine smtbmc|abc`, `induction yes|no` (the unbounded proof), `depth N`, `assert_inputs
+#   MODULE...` (a system proof: those submodules' assumptions on their inputs become assertions
+#   of the composition, so each is proven of the module that drives it).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; }
 [[ $# -ge 1 ]] || { usage >&2; exit 2; }
 case "$1" in -h|--help) usage; exit 0 ;; esac
 job=$1; shift
@@ -32,7 +35,7 @@ while [[ $# -gt 0 ]]; do
 done
 jf="$root/formal/$job.job"
 [[ -f "$jf" ]] || { echo "run_formal: no job file $jf" >&2; exit 2; }
-top=""; files=(); chp=""; induction=yes; jdepth=24; defines=""; engine=smtbmc
+top=""; files=(); chp=""; induction=yes; jdepth=24; defines=""; engine=smtbmc; a2a=""; a2a_mods=()
 while read -r key rest; do
   case "$key" in
     ''|'#'*) ;;
@@ -42,6 +45,8 @@ while read -r key rest; do
     define) defines+=" -D$rest" ;;
     induction) induction=$rest ;;
     depth) jdepth=$rest ;;
+    assert_inputs) read -r -a a2a_mods <<<"$rest"
+                   for m in "${a2a_mods[@]}"; do a2a+="chformal -assume -assume2assert *$m*; "; done ;;
     engine) engine=$rest
             [[ $engine == smtbmc || $engine == abc ]] || { echo "run_formal: $jf: engine must be smtbmc or abc, got '$engine'" >&2; exit 2; } ;;
     *) echo "run_formal: $jf: unknown key '$key'" >&2; exit 2 ;;
@@ -58,17 +63,22 @@ out=${out:-"${TMPDIR:-/tmp}/ranging-formal-$job-$$"}
 mkdir -p "$out"
 uc=$(echo "$top" | tr a-z A-Z)
 rc=""
-for f in "${files[@]}"; do rc+="read_verilog -formal -DFORMAL -DF_$uc$defines $rtl/$f; "; done
+for f in "${files[@]}"; do
+  # formal/NAME.v: a proof's environment model beside the jobs; anything else is an RTL file
+  if [[ $f == formal/* ]]; then fp="$root/$f"; else fp="$rtl/$f"; fi
+  rc+="read_verilog -formal -DFORMAL -DF_$uc$defines $fp; "
+done
 if [[ $engine == abc ]]; then
   # one AIGER model (assertions as bad states, assumptions as constraints; uninitialized
   # registers free at step 0), as SymbiYosys writes it for its abc engines
-  yosys -q -l "$out/$job-yosys.log" -p "$rc $chp prep -top $top; flatten; memory_map; opt -fast; async2sync; \
+  yosys -q -l "$out/$job-yosys.log" -p "$rc $chp prep -top $top; $a2a flatten; memory_map; opt -fast; async2sync; \
       chformal -assume -early; setundef -undriven -anyseq; opt -fast; delete -output; techmap; \
       opt -fast; abc -g AND -fast; opt_clean; dffunmap; aigmap; tee -q -o $out/$job-asserts.txt select -list t:\$assert; \
       write_aiger -I -B -zinit -map $out/$job.aim $out/$job.aig" >/dev/null \
     || { echo "run_formal: yosys failed, see $out/$job-yosys.log" >&2; exit 2; }
   # bad-state outputs are numbered in the order of the model's assertion cells
-  name_of() { grep -F "/\$assert" "$out/$job-asserts.txt" | sed -n "$(( $1 + 1 ))p"; }
+  # (an assumption turned into an assertion by assert_inputs keeps its $assume name)
+  name_of() { grep -E '[./]\$(assert|assume)\$' "$out/$job-asserts.txt" | sed -n "$(( $1 + 1 ))p"; }
   abc_run() {  # abc_run KIND COMMAND
     yosys-abc -c "read_aiger $out/$job.aig; fold; strash; $2; write_cex -a $out/$job-$1.aiw" >"$out/$job-$1.log" 2>&1 \
       || { echo "run_formal: yosys-abc failed, see $out/$job-$1.log" >&2; exit 2; }
@@ -95,7 +105,7 @@ if [[ $engine == abc ]]; then
   exit 0
 fi
 # one SMT2 model of the flattened design; async2sync/dffunmap as SymbiYosys' prep does
-yosys -q -l "$out/$job-yosys.log" -p "$rc $chp prep -top $top; flatten; opt_clean; async2sync; chformal -assume -early; dffunmap; \
+yosys -q -l "$out/$job-yosys.log" -p "$rc $chp prep -top $top; $a2a flatten; opt_clean; async2sync; chformal -assume -early; dffunmap; \
     write_smt2 -wires $out/$job.smt2" >/dev/null || { echo "run_formal: yosys failed, see $out/$job-yosys.log" >&2; exit 2; }
 status=0
 t0=$(date +%s)

@@ -165,11 +165,19 @@ module ranging_system #(
     end
   endgenerate
 
+  // The frame's overrun flag: led_error (sticky, it may rise at any sample) taken while no
+  // measurement waits, so a measurement's fields stay stable until the UART has sent it
+  // (AXI-Stream; found by the system proof, formal/ranging_system.job).
+  reg frame_error;
+  always @(posedge clk)
+    if (rst) frame_error <= 1'b0;
+    else if (!m_valid || m_ready) frame_error <= led_error;
+
   measurement_uart #(.BAUD_DIV(BAUD_DIV)) u_uart (
     .clk(clk), .rst(rst),
     .s_valid(m_valid), .s_ready(m_ready),
     .s_code({{(8-CODE_W){1'b0}}, m_code}),
-    .s_flags({5'd0, led_error, m_flags}),
+    .s_flags({5'd0, frame_error, m_flags}),
     .s_tof(m_tof), .s_distance(m_distance), .s_score(f_score), .s_margin(f_margin),
     .tx(uart_tx)
   );
@@ -192,6 +200,26 @@ module ranging_system #(
   end
 
   wire unused = &{1'b0, overruns};
+
+`ifdef FORMAL
+  // System proof (formal/run_formal.sh ranging_system; formal/receiver_env.v stands in for the
+  // receiver): the submodules' input rules are asserted of the modules that drive them (the job's
+  // assert_inputs): the ADC's tick against tx_scheduler's spacing, the events against
+  // tof_distance, the measurements against measurement_uart and its bytes against uart_tx. Here:
+  // reset first, and the system's outputs after reset.
+  reg f_past_valid = 1'b0;
+  always @(posedge clk) f_past_valid <= 1'b1;
+  always @(*) if (!f_past_valid) assume(rst);
+  always @(posedge clk)
+    if (f_past_valid && $past(rst))
+      assert(!hb_p && !hb_n && !tx_active && uart_tx && !led_meas && !led_error && !meas_valid);
+  // the H-bridge never drives both legs, and drives only in a burst
+  always @(*)
+    if (f_past_valid && !rst) begin
+      assert(!(hb_p && hb_n));
+      if (hb_p || hb_n) assert(tx_active);
+    end
+`endif
 endmodule
 
 `default_nettype wire

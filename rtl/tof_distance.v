@@ -100,6 +100,11 @@ module tof_distance #(
   localparam integer LO_W = TOF_W - SH;               // product bits below hi that reach the distance
   localparam integer CNT_W = ($clog2(TOF_W) > KW + 1 ? $clog2(TOF_W) : KW + 1);
   localparam integer CYCLE = CODES * PERIOD_T;
+  generate
+    if (TOF_W > DW - 1) begin : g_bad_tof_w
+      initial $error("tof_distance: TOF_W %0d wider than A - t 2^FRAC_W can be (max(TIME_W + FRAC_W + 1, OFF_W) + 1 = %0d)", TOF_W, DW - 1);
+    end
+  endgenerate
   localparam [2:0] IDLE = 0, BACK = 1, TOF = 2, MUL = 3, CLAMP = 4, OUT = 5, TOF0 = 6;
 
   reg [2:0] state;
