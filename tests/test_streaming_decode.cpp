@@ -120,6 +120,26 @@ TEST(StreamingDecode, WavEqualsWholeFileAtEveryBlockSize) {
   check_file(p, "fixed");
 }
 
+// The bursts' metrics on several threads (decode --jobs): the same detections, bit for bit, at
+// blocks that leave bursts pending across blocks (64: T_d searches retried) or none.
+TEST(StreamingDecode, SeveralThreadsGiveTheSameDetections) {
+  const std::string p = write("jobs.wav", capture_wav(capture(), WavFormat::Float32));
+  const Capture whole = read_capture(p);
+  for (const std::string precision : {"float", "fixed"}) {
+    SceneSimulator sim(decode_scene(precision));
+    const auto ref = sim.decode("Gold4", whole.samples, whole.t0, 0.002);
+    ASSERT_GE(ref.size(), 10u);
+    CaptureSource src(p);
+    for (int jobs : {2, 3}) {
+      sim.set_jobs(jobs);
+      for (std::size_t block : {std::size_t{64}, std::size_t{4096}, std::size_t{1} << 20}) {
+        SCOPED_TRACE(precision + ", jobs " + std::to_string(jobs) + ", block " + std::to_string(block));
+        expect_same(ref, sim.decode_stream("Gold4", src, 0.002, block));
+      }
+    }
+  }
+}
+
 TEST(StreamingDecode, Pcm16WavAndCsvEqualWholeFile) {
   check_file(write("train16.wav", capture_wav(capture(), WavFormat::Pcm16, 0.5)), "fixed");
   Capture c = capture();
@@ -196,9 +216,10 @@ TEST(StreamingDecode, ToolPrintsTheSameDetectionsAtAnyBlockSize) {
     auto j = nlohmann::json::parse(r.out);
     return std::make_pair(j["detections"], j["below_gate"]);
   };
-  const auto big = run("1048576"), small = run("64");
+  const auto big = run("1048576"), small = run("64"), threads = run("4096 --jobs 2");
   EXPECT_GE(big.first.size(), 10u);
   EXPECT_EQ(big, small);
+  EXPECT_EQ(big, threads);
   const auto bad = testing_support::run_tool("decode \"" + p + "\" --block-samples 10");
   EXPECT_EQ(bad.status, 2);
   EXPECT_TRUE(bad.out.empty());

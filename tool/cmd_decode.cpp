@@ -113,6 +113,7 @@ int cmd_decode(const Args& args) {
   p.option("--plot", "FILE.png", "draw the capture, the bandpass output and the bank's rho^2 per code with the detections");
   add_output_options(p, {.json = true});
   p.option("--block-samples", "N", "the capture is streamed in blocks of N samples, 64..67108864 (memory, not results, depends on it)", "1048576");
+  add_jobs_option(p, "bursts' metrics (Pearson rho, T_d, energy) computed");
   if (!p.parse(args)) return 0;
   const std::string path = p.positionals().at(0);
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
@@ -199,6 +200,7 @@ int cmd_decode(const Args& args) {
   };
   check_len(cap.size(), path);
   SceneSimulator sim(scene);
+  sim.set_jobs(jobs_option(p));
 
   std::optional<LatencyCalibration> cal;
   if (p.has("--calibrate")) {

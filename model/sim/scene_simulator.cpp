@@ -948,6 +948,11 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
   BandpassFloat bp(lk.design.filter);
   const double inv = 1.0 / scale;
   const bool fixed = lk.fixed();
+  // jobs_ - 1 more matched-filter banks for the worker threads (this thread uses lk.bank)
+  std::vector<std::unique_ptr<PearsonBank>> banks;
+  if (scene_.receiver.metrics.pearson) {
+    for (int t = 1; t < jobs_; ++t) banks.push_back(std::make_unique<PearsonBank>(lk.templates));
+  }
   src.rewind();
   for (std::size_t k; (k = src.read(x)) > 0;) {
     // The block form (bit for bit execute() per sample); scaled as receive() scales.
@@ -963,10 +968,47 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     }
     const long avail = base + static_cast<long>(w.size());
     while (next < order.size() && needs[order[next]].lo < avail) active.push_back(order[next++]);
-    std::erase_if(active, [&](std::size_t i) {
-      return avail >= needs[i].hi_min &&
-             lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, *lk.bank);
-    });
+    // The bursts whose window is in: their metrics (each reads w and writes its own Detection
+    // only) on up to jobs_ threads, each with its own PearsonBank; done[i] says which finished.
+    std::vector<std::size_t> ready;
+    for (std::size_t i : active) {
+      if (avail >= needs[i].hi_min) ready.push_back(i);
+    }
+    std::vector<char> done(ready.size(), 0);
+    const std::size_t nt = std::min(static_cast<std::size_t>(std::max(jobs_, 1)), ready.size());
+    if (nt <= 1) {
+      for (std::size_t r = 0; r < ready.size(); ++r) {
+        const auto i = ready[r];
+        done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, *lk.bank);
+      }
+    } else {
+      std::vector<std::exception_ptr> errors(ready.size());
+      std::atomic<std::size_t> at{0};
+      auto work = [&](PearsonBank& pb) {
+        for (std::size_t r = at++; r < ready.size(); r = at++) {
+          const auto i = ready[r];
+          try {
+            done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, pb);
+          } catch (...) {
+            errors[r] = std::current_exception();
+          }
+        }
+      };
+      std::vector<std::thread> pool;
+      // (without Pearson outputs the bank is not used: every thread may name lk.bank)
+      for (std::size_t t = 0; t + 1 < nt; ++t) pool.emplace_back(work, std::ref(banks.empty() ? *lk.bank : *banks[t]));
+      work(*lk.bank);
+      for (auto& t : pool) t.join();
+      for (const auto& e : errors) {
+        if (e) std::rethrow_exception(e);  // the first in burst order
+      }
+    }
+    std::vector<std::size_t> finished;
+    for (std::size_t r = 0; r < ready.size(); ++r) {
+      if (done[r]) finished.push_back(ready[r]);
+    }
+    std::sort(finished.begin(), finished.end());
+    std::erase_if(active, [&](std::size_t i) { return std::binary_search(finished.begin(), finished.end(), i); });
     long keep = next < order.size() ? std::min(avail, needs[order[next]].lo) : avail;
     for (std::size_t i : active) keep = std::min(keep, needs[i].lo);
     if (static_cast<std::size_t>(keep - base) >= block && static_cast<std::size_t>(keep - base) * 2 >= w.size()) {
