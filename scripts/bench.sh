@@ -41,6 +41,8 @@ printf '%s\n' "name: train" "medium: {temperature_c: 20}" "transducers: {}" "geo
 for n in ${BENCH_DECODE_SAMPLES:-1e7 1e8}; do
   $PY scripts/make_long_capture.py "$T/train/captures/Gold4_500mm_r1.wav" "$n" "$T/long.wav" 9
   /usr/bin/time -v "$B"/tool/ranging decode "$T/long.wav" --json >"$T/long.out" 2>"$T/long.time"
+  # the bursts' metrics on 2 threads (decode --jobs 2, the same output): wall seconds
+  /usr/bin/time -f %e -o "$T/long2.time" "$B"/tool/ranging decode "$T/long.wav" --json --jobs 2 >/dev/null
   $PY -c '
 import json, re, sys
 t = open(sys.argv[2]).read()
@@ -49,8 +51,9 @@ cpu = g("User time") + g("System time")
 n = float(sys.argv[1])
 dets = len(json.load(open(sys.argv[3]))["detections"])
 rss = g("Maximum resident set size") / 1024
-print(f"{n:.0e} {cpu:.3f} {n / cpu / 1e6:.2f} {rss:.1f} {dets}")
-' "$n" "$T/long.time" "$T/long.out" >>"$T/decode.txt"
+w2 = float(open(sys.argv[4]).read().split()[-1])
+print(f"{n:.0e} {cpu:.3f} {n / cpu / 1e6:.2f} {rss:.1f} {dets} {w2:.3f} {n / w2 / 1e6:.2f}")
+' "$n" "$T/long.time" "$T/long.out" "$T/long2.time" >>"$T/decode.txt"
   rm -f "$T/long.wav" "$T/long.json" "$T/long.out"
 done
 # Several cores: the default scene's streams (20 repeats: 900 streams) on 1 and 2 threads (same output: tests/test_parallel_streams).
@@ -115,10 +118,11 @@ print(f"  ratios: block kernel / sosfilt (4096) {kb/s4:.2f}, / sosfilt (1 M) {kb
       f"/ sc_fixed {kb/sc:.0f}; per-sample kernel / sc_fixed {k/sc:.0f}")
 print()
 print("Streaming decode (ranging decode --json of a WAV train, /usr/bin/time -v; MS/s per CPU second):")
-print(f"  {'samples':>8s} {'CPU s':>8s} {'MS/s':>8s} {'peak RSS MB':>12s} {'bursts':>7s}")
+print(f"  {'samples':>8s} {'CPU s':>8s} {'MS/s':>8s} {'peak RSS MB':>12s} {'bursts':>7s} "
+      f"{'--jobs 2 wall s':>16s} {'MS/s (wall)':>12s}")
 for line in open(f"{t}/decode.txt"):
-    n, cpu, rate, rss, dets = line.split()
-    print(f"  {n:>8s} {cpu:>8s} {rate:>8s} {rss:>12s} {dets:>7s}")
+    n, cpu, rate, rss, dets, w2, r2 = line.split()
+    print(f"  {n:>8s} {cpu:>8s} {rate:>8s} {rss:>12s} {dets:>7s} {w2:>16s} {r2:>12s}")
 print()
 w = {j: [float(v) for v in open(f"{t}/jobs{j}.time").read().split()] for j in (1, 2)}
 print("Several cores (simulate scenes/default.yaml --set geometry.repeats=20; wall time, user+sys CPU):")
