@@ -5,15 +5,25 @@
 //   Fixed/Bank       CorrelatorBankFixed::feed on the filtered signal
 //   Fixed/Receiver   ReceiverFixed::execute_block: bandpass + bank + detector
 //   Float/...        the same stages of the double-precision reference, per sample
-// The detector's share is Receiver - Bandpass - Bank. items_per_second = samples/s.
+// The detector's share is Receiver - Bandpass - Bank. The channel's stages:
+//   WhiteNoise      add_white_noise (Boost ziggurat + mt19937_64), the scenes' noise
+//   StdNormalNoise  std::normal_distribution + std::mt19937_64, the generator it replaced
+//   Adc             adc_quantize, the scenes' 12-bit ADC
+//   ChannelClean    propagate without noise: two transducers and the 64-tap fractional delay
+//                   (a scene computes this once per code and distance, then reuses it)
+// items_per_second = samples/s.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <random>
 #include <vector>
 
 #include "model/config/receiver_config.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/receiver.hpp"
 #include "model/sim/channel.hpp"
+#include "model/sim/front_end.hpp"
+#include "model/sim/scene.hpp"
 
 int sc_main(int, char**) { return 0; }  // the bench programs link libsystemc, which references it
 
@@ -149,6 +159,58 @@ void BM_FloatReceiver(benchmark::State& state) {
   items(state);
 }
 
+void BM_WhiteNoise(benchmark::State& state) {
+  const Setup& s = setup();
+  std::vector<double> y(s.x);
+  std::uint64_t seed = 1;
+  for (auto _ : state) {
+    add_white_noise(y, 0.002, seed++);
+    benchmark::DoNotOptimize(y.data());
+  }
+  items(state);
+}
+
+void BM_StdNormalNoise(benchmark::State& state) {
+  const Setup& s = setup();
+  std::vector<double> y(s.x);
+  std::uint64_t seed = 1;
+  for (auto _ : state) {
+    std::mt19937_64 rng(seed++);
+    std::normal_distribution<double> nd(0.0, 0.002);
+    for (double& v : y) v += nd(rng);
+    benchmark::DoNotOptimize(y.data());
+  }
+  items(state);
+}
+
+void BM_Adc(benchmark::State& state) {
+  const Setup& s = setup();
+  SceneAdc adc;  // scenes/default.yaml: 12 bits, +-2 V
+  adc.bits = 12;
+  adc.full_scale_v = 2.0;
+  std::vector<double> y(s.x.size());
+  std::vector<std::size_t> clipped;
+  for (auto _ : state) {
+    std::copy(s.x.begin(), s.x.end(), y.begin());
+    clipped.clear();
+    benchmark::DoNotOptimize(adc_quantize(y, adc, &clipped));
+  }
+  items(state);
+}
+
+void BM_ChannelClean(benchmark::State& state) {
+  const Setup& s = setup();
+  ExcitationParams ex;
+  const auto e = bpsk_excitation(s.d.family.codes[0], ex);
+  ChannelParams ch;
+  ch.distance_m = 0.5;
+  for (auto _ : state) {
+    const auto y = propagate(e, ch, s.d.config.fs, s.x.size());
+    benchmark::DoNotOptimize(y.data());
+  }
+  items(state);
+}
+
 BENCHMARK(BM_FixedBandpass)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FixedBank)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FixedReceiver)->Unit(benchmark::kMicrosecond);
@@ -156,5 +218,9 @@ BENCHMARK(BM_FixedReceiverPerSample)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FloatBandpass)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FloatBank)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FloatReceiver)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WhiteNoise)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_StdNormalNoise)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Adc)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ChannelClean)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

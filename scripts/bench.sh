@@ -70,8 +70,8 @@ scene_run() {  # NAME SCENE REPEATS [ARGS...]
   shift 3
   for r in 1 "$reps"; do
     /usr/bin/time -f "%U %S" -o "$T/scene.time" "$B"/tool/ranging simulate "$scene" --set geometry.repeats=$r \
-      --out "$T/scene" --quiet "$@" >/dev/null
-    echo "$name $r $(cat "$T/scene.time") $($PY -c 'import json,sys; print(json.load(open(sys.argv[1]))["samples_simulated"])' "$T/scene/summary.json")"
+      --out "$T/scene" --quiet --timing "$@" >/dev/null
+    echo "$name $r $(cat "$T/scene.time") $($PY -c 'import json,sys; j = json.load(open(sys.argv[1])); t = j["stage_seconds"]; print(j["samples_simulated"], t["channel"], t["receiver"], t["metrics"])' "$T/scene/summary.json")"
   done >>"$T/scenes.txt"
 }
 : >"$T/scenes.txt"
@@ -100,6 +100,13 @@ for prec in ("Fixed", "Float"):
     row(f"{prec.lower()} receiver (all stages)", rx)
 row("fixed receiver, per-sample API", m["BM_FixedReceiverPerSample"])
 print(f"  float / fixed receiver: {m['BM_FloatReceiver'] / m['BM_FixedReceiver']:.2f}")
+print()
+print("Channel stages (bench_model, the same input):")
+row("white noise (Boost ziggurat)", m["BM_WhiteNoise"])
+row("std::normal_distribution (before)", m["BM_StdNormalNoise"])
+row("ADC, 12 bits", m["BM_Adc"])
+row("clean burst (transducers, delay)", m["BM_ChannelClean"])
+print(f"  white noise / std::normal_distribution: {m['BM_WhiteNoise'] / m['BM_StdNormalNoise']:.2f}x")
 print()
 k, kt = f["BM_BandpassFixed"], f["BM_FixedType"]
 sc, scf = f["BM_ScFixed"], f["BM_ScFix"]
@@ -134,13 +141,16 @@ print()
 print("Scenes, per received sample (simulate; CPU of a long run minus a 1-repeat run, over the samples between):")
 sc = {}
 for line in open(f"{t}/scenes.txt"):
-    name, r, u, sy, n = line.split()
-    sc.setdefault(name, {})[int(r)] = (float(u) + float(sy), int(n))
+    name, r, u, sy, n, ch, rx, mt = line.split()
+    sc.setdefault(name, {})[int(r)] = (float(u) + float(sy), int(n), float(ch), float(rx), float(mt))
 ns = {}
 for name, v in sc.items():
-    (c1, n1), (cr, nr) = v[1], max(v.items())[1]
+    (c1, n1, ch1, rx1, mt1), (cr, nr, chr_, rxr, mtr) = v[1], max(v.items())[1]
     ns[name] = (cr - c1) / (nr - n1) * 1e9
-    print(f"  {name:26s} {ns[name]:8.1f} ns/sample {1e3 / ns[name]:8.1f} MS/s {1e3 / ns[name] / 5:8.1f} x real time")
+    per = lambda a, b: (b - a) / (nr - n1) * 1e9
+    print(f"  {name:26s} {ns[name]:8.1f} ns/sample {1e3 / ns[name]:8.1f} MS/s {1e3 / ns[name] / 5:8.1f} x real time;"
+          f" per stage (simulate --timing) channel {per(ch1, chr_):5.1f} ({1e3 / max(per(ch1, chr_), 1e-9) / 5:5.1f}x real time),"
+          f" receiver {per(rx1, rxr):5.1f}, metrics {per(mt1, mtr):5.1f} ns/sample")
 print(f"  default / minimal per sample: {ns['default'] / ns['minimal']:.2f} (target >= 5); fixed precision, "
       f"metrics [] / all: {ns['default-fixed-no-metrics'] / ns['default-fixed']:.2f}")
 print()

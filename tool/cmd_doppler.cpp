@@ -38,7 +38,7 @@ int cmd_doppler(const Args& args) {
   }
   SceneSimulator sim(scene);
   std::ostringstream csv;
-  csv << "los_speed_mps,doppler,bursts,decoded,misdecoded,missed,bias_start_m,bias_centre_m,std_m\n";
+  csv << "los_speed_mps,doppler,bursts,decoded,misdecoded,missed,bias_start_m,bias_centre_m,std_m,adc_clipped\n";
   std::printf("%10s %8s %6s %7s %7s %6s %13s %14s %9s\n", "v_los_m/s", "doppler", "bursts", "decoded", "misdec",
               "missed", "bias_start_mm", "bias_centre_mm", "std_mm");
   for (double v : speeds) {
@@ -46,7 +46,11 @@ int cmd_doppler(const Args& args) {
     std::printf("%10.2f %8.4f %6d %7d %7d %6d %13.4f %14.4f %9.4f\n", v, pt.doppler, pt.bursts, pt.decoded,
                 pt.misdecoded, pt.missed, pt.bias_start_m * 1e3, pt.bias_centre_m * 1e3, pt.std_m * 1e3);
     csv << v << ',' << pt.doppler << ',' << pt.bursts << ',' << pt.decoded << ',' << pt.misdecoded << ',' << pt.missed
-        << ',' << pt.bias_start_m << ',' << pt.bias_centre_m << ',' << pt.std_m << '\n';
+        << ',' << pt.bias_start_m << ',' << pt.bias_centre_m << ',' << pt.std_m << ',' << pt.adc_clipped << '\n';
+    if (pt.adc_clipped) {
+      std::fprintf(stderr, "doppler: warning: at %.2f m/s the ADC clipped %llu received samples\n", v,
+                   static_cast<unsigned long long>(pt.adc_clipped));
+    }
   }
   if (p.has("--out")) write_file_atomic(*p.get("--out"), csv.str());
   return 0;

@@ -250,6 +250,8 @@ int cmd_simulate(const Args& args) {
                          .json_note = "the summary JSON on stdout instead of the text summary", .quiet = true});
   p.flag("--write-captures", "also write every received stream as DIR/captures/*.csv and *.wav");
   p.option("--plot", "FILE.png", "draw the distance error against the true distance, per family");
+  p.flag("--timing", "also record the seconds spent per stage (channel, receiver, metrics; summed over\n"
+                     "threads) in summary.json as stage_seconds: a speed figure that changes run to run");
   add_jobs_option(p, "streams (distances, repeats, codes) simulated", "; --precision rtl runs one");
   add_scene_options(p);
   if (!p.parse(args)) return 0;
@@ -281,6 +283,9 @@ int cmd_simulate(const Args& args) {
   const bool json = p.has("--json");
   if (scene.geometry.type == "rotor" && p.has("--plot")) {
     throw InputError("option --plot: not available for rotor scenes");
+  }
+  if (scene.geometry.type == "rotor" && p.has("--timing")) {
+    throw InputError("option --timing: not available for rotor scenes");
   }
   if (scene.geometry.type == "rotor" && p.has("--write-captures")) {
     throw InputError("option --write-captures: not available for rotor scenes");
@@ -320,6 +325,10 @@ int cmd_simulate(const Args& args) {
   nlohmann::json summary = summary_json(sim, run);
   // The guard's verdict on the receiver's quantized filter (refused at load unless allowed).
   summary["design_guard"] = guard_json(check_quantized_design(scene.receiver.config), scene.receiver.config.filter_order);
+  if (p.has("--timing")) {
+    const StageSeconds& t = sim.stage_seconds();
+    summary["stage_seconds"] = {{"channel", t.channel}, {"receiver", t.receiver}, {"metrics", t.metrics}};
+  }
   if (rtl) {
     summary["precision"] = "rtl";
     summary["rtl"] = rtl_check.run();

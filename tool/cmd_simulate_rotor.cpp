@@ -65,7 +65,8 @@ int simulate_rotor(SceneSimulator& sim, const std::string& out, bool json, bool 
 
   nlohmann::json j = {{"scene", s.name}, {"geometry", "rotor"}, {"family", run.family},
                       {"period_s", run.period_s}, {"burst_s", run.burst_s}, {"relative_tip_speed_mps", run.v_rel},
-                      {"misdecodes", run.misdecodes}, {"false_alarms", run.false_alarms}, {"overflows", run.overflows}};
+                      {"misdecodes", run.misdecodes}, {"false_alarms", run.false_alarms}, {"overflows", run.overflows},
+                      {"adc_clipped", run.adc_clipped}};
   Stats motion, paper;
   std::size_t fail_motion = 0, fail_paper = 0, decoded = 0;
   for (const auto& b : run.bursts) decoded += b.decoded;
@@ -121,9 +122,9 @@ int simulate_rotor(SceneSimulator& sim, const std::string& out, bool json, bool 
     return std::string(b);
   };
   std::printf("\n%zu crossings, %zu bursts rendered, %zu decoded, %zu misdecoded, %zu false alarms, %llu fixed-point"
-              " saturations/wraps\n",
+              " saturations/wraps, %llu ADC samples clipped\n",
               run.crossings.size(), run.bursts.size(), decoded, run.misdecodes, run.false_alarms,
-              static_cast<unsigned long long>(run.overflows));
+              static_cast<unsigned long long>(run.overflows), static_cast<unsigned long long>(run.adc_clipped));
   std::printf("h error rms, motion-aware: %s; %zu crossings estimated, %zu not\n", rms(motion).c_str(), motion.n,
               fail_motion);
   std::printf("h error rms, paper eq. 1:  %s; %zu crossings estimated, %zu not\n", rms(paper).c_str(), paper.n,

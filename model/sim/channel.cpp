@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <random>
 #include <string>
 #include <utility>
 
 #include "model/base/error.hpp"
 #include "model/dsp/filter_design.hpp"
+#include "model/sim/front_end.hpp"
 
 namespace ranging {
 
@@ -79,11 +79,7 @@ std::vector<double> propagate(std::span<const double> excitation, const ChannelP
       y[k] = g * acc;
     }
   }
-  if (p.noise_rms > 0.0) {
-    std::mt19937_64 rng(p.seed);
-    std::normal_distribution<double> noise(0.0, p.noise_rms);
-    for (auto& v : y) v += noise(rng);
-  }
+  add_white_noise(y, p.noise_rms, p.seed);
   return y;
 }
 

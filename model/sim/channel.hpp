@@ -5,8 +5,8 @@
 // (transducer.hpp); the propagation delay d/c is applied exactly by a 64-tap
 // Kaiser-windowed-sinc fractional-delay interpolator (delay error < 1e-5 sample and gain
 // error < 4e-6 from 100 kHz to 2 MHz at 5 MS/s, docs/signal-model.md); the gain follows
-// spherical spreading 1/d from a 0.1 m reference; w is white Gaussian noise (std::mt19937_64 +
-// std::normal_distribution, deterministic for a given seed with this libstdc++).
+// spherical spreading 1/d from a 0.1 m reference; w is white Gaussian noise drawn from the
+// seed (add_white_noise, model/sim/front_end.hpp).
 // Absent in the model: absorption, multipath, turbulence, transducer directivity.
 #include <cstddef>
 #include <cstdint>

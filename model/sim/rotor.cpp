@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <random>
 #include <sstream>
 
 #include "model/base/error.hpp"
@@ -12,6 +11,7 @@
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/transducer.hpp"
 #include "model/sim/channel.hpp"
+#include "model/sim/front_end.hpp"
 #include "model/sim/medium.hpp"
 #include "model/sim/metrics.hpp"
 #include "model/sim/scene.hpp"
@@ -256,8 +256,9 @@ namespace {
 // What the rotor crossings and the Doppler points share: the scene's first family sent every
 // period through the moving channel (model/sim/moving_channel.hpp).
 struct MovingReception {
-  std::vector<double> y;  // the ADC's output, volts
-  long r0 = 0;            // the sample of y[0]
+  std::vector<double> y;         // the ADC's output, volts
+  long r0 = 0;                   // the sample of y[0]
+  std::size_t adc_clipped = 0;   // samples the ADC clipped
 };
 
 struct MovingBursts {
@@ -318,15 +319,9 @@ struct MovingBursts {
         const double a = s.excitation.amplitude() * s.sensitivity * kReferenceDistance / d;
         sigma = std::sqrt(a * a / 2.0 / std::pow(10.0, *s.noise.snr_db / 10.0));
       }
-      std::mt19937_64 rng(seed);
-      std::normal_distribution<double> nd(0.0, sigma);
-      for (double& v : y) v += nd(rng);
+      add_white_noise(y, sigma, seed);
     }
-    if (s.noise.adc) {
-      const double qv = s.noise.adc->full_scale_v / std::ldexp(1.0, s.noise.adc->bits - 1);
-      const double top = std::ldexp(1.0, s.noise.adc->bits - 1);
-      for (double& v : y) v = std::clamp(std::round(v / qv), -top, top - 1) * qv;
-    }
+    if (s.noise.adc) out.adc_clipped = adc_quantize(y, *s.noise.adc, nullptr);
     return out;
   }
 };
@@ -389,6 +384,7 @@ RotorRun run_rotor(SceneSimulator& sim, const std::function<void()>& tick) {
     std::uint64_t ov = 0;
     const auto dets = sim.receive_stream(family, y, static_cast<double>(r0) / fs, run.period_s, &ov);
     run.overflows += ov;
+    run.adc_clipped += rx.adc_clipped;
 
     // Truth per burst.
     std::vector<RotorBurst> bursts;
@@ -496,6 +492,7 @@ DopplerPoint doppler_point(SceneSimulator& sim, double d, double v_los, int repe
     const long r0 = rx.r0;
     const std::vector<double>& y = rx.y;
     const auto dets = sim.receive_stream(mb.family, y, static_cast<double>(r0) / fs, T);
+    out.adc_clipped += rx.adc_clipped;
     const double t_start = reception_time(link, tk, tk + d / c);
     const double tcen = tk + tb / 2;
     const double t_centre = reception_time(link, tcen, tcen + d / c);

@@ -142,6 +142,7 @@ struct RotorRun {
   std::vector<RotorBurst> bursts;
   std::size_t misdecodes = 0, false_alarms = 0;
   std::uint64_t overflows = 0;
+  std::uint64_t adc_clipped = 0;  // received samples the scene's ADC clipped (every crossing)
 };
 
 // Doppler at a constant line-of-sight speed: the TX fixed at height d, the RX moving along the
@@ -151,6 +152,7 @@ struct RotorRun {
 struct DopplerPoint {
   double los_speed_mps = 0, doppler = 1;   // received / emitted frequency
   int bursts = 0, decoded = 0, misdecoded = 0, missed = 0;
+  std::uint64_t adc_clipped = 0;           // received samples the scene's ADC clipped
   double bias_start_m = std::numeric_limits<double>::quiet_NaN();   // mean c (ToF - true start) over decoded
   double bias_centre_m = std::numeric_limits<double>::quiet_NaN();  // ... against the centre's flight time
   double std_m = std::numeric_limits<double>::quiet_NaN();          // spread of c ToF

@@ -9,13 +9,13 @@
 #include <limits>
 #include <map>
 #include <numbers>
-#include <random>
 #include <sstream>
 #include <thread>
 
 #include "model/sim/capture.hpp"
 #include "model/sim/capture_stream.hpp"
 #include "model/sim/channel.hpp"
+#include "model/sim/front_end.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/latency.hpp"
@@ -608,6 +608,31 @@ SceneSimulator::Link& SceneSimulator::link(const std::string& family) {
 }
 
 namespace {
+// f(i, t) for every i in [0, n) on `threads` threads (t: the thread's index; thread 0 is the
+// caller), items handed out in order. An exception of f is kept per item; once every thread has
+// joined, the first in item order is rethrown.
+template <class F>
+void parallel_items(std::size_t n, std::size_t threads, F f) {
+  std::vector<std::exception_ptr> errors(n);
+  std::atomic<std::size_t> next{0};
+  auto work = [&](std::size_t t) {
+    for (std::size_t i = next++; i < n; i = next++) {
+      try {
+        f(i, t);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (auto& t : pool) t.join();
+  for (const auto& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+}
+
 std::vector<int> codes_sent(const Scene& s, int eta) {
   std::vector<int> codes = s.excitation.codes;
   if (codes.empty()) {
@@ -651,6 +676,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     int rep = 0;
   };
   std::vector<Item> items;
+  StageClock clean_clk;
   for (std::size_t di = 0; di < s.geometry.distances_m.size(); ++di) {
     for (const auto& train : trains) {
       for (const auto& b : train) (void)lk.clean(b.code, s.geometry.distances_m[di]);
@@ -660,6 +686,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       for (std::size_t ti = 0; ti < trains.size(); ++ti) items.push_back({di, ti, rep});
     }
   }
+  stage_s_.channel += clean_clk.lap();  // the clean bursts: transducers, medium, fractional delay
   // The noise stage's sigma for a measurement at d: snr_db is against the mean square of the
   // noise-free burst (the train's first code at d) over its T_d; the compensation reference
   // shares the measurement's sigma (the same electronics).
@@ -695,30 +722,9 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
         hv.f64(b.tx_s);
       }
       if (salt != 0) hv.u64(salt);
-      const std::uint64_t seed = splitmix(hv.h);
-      std::mt19937_64 rng(seed);
-      std::normal_distribution<double> nd(0.0, sigma);
-      for (double& v : x) v += nd(rng);
+      add_white_noise(x, sigma, splitmix(hv.h));
     }
-    if (s.noise.adc) {
-      const SceneAdc& a = *s.noise.adc;
-      const double q = a.full_scale_v / std::ldexp(1.0, a.bits - 1);
-      const double top = std::ldexp(1.0, a.bits - 1);
-      const auto mask = (std::uint64_t{1} << a.bits) - 1;
-      for (std::size_t n = 0; n < x.size(); ++n) {
-        const double r = round_half_away((x[n] + a.dc_offset_v) / q);  // std::round, inlined
-        if (r < -top || r > top - 1) clipped.push_back(n);
-        auto code = static_cast<std::int64_t>(std::clamp(r, -top, top - 1));
-        if (a.stuck_bit >= 0) {  // two's complement of `bits` bits, the bit forced, sign-extended back
-          std::uint64_t u = static_cast<std::uint64_t>(code) & mask;
-          const std::uint64_t bit = std::uint64_t{1} << a.stuck_bit;
-          u = a.stuck_value ? (u | bit) : (u & ~bit);
-          code = (u & (std::uint64_t{1} << (a.bits - 1))) ? static_cast<std::int64_t>(u) - static_cast<std::int64_t>(mask) - 1
-                                                         : static_cast<std::int64_t>(u);
-        }
-        x[n] = static_cast<double>(code) * q;
-      }
-    }
+    if (s.noise.adc) (void)adc_quantize(x, *s.noise.adc, &clipped);
   };
   // One stream: its measurements, false alarms, overflows and (for the capture callback) its samples.
   struct StreamOut {
@@ -726,11 +732,13 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     std::size_t fa = 0;
     std::uint64_t ovf = 0;
     std::uint64_t samples = 0;  // received samples simulated (the measurement's and its reference's)
+    StageSeconds t;             // this stream's time per stage
     std::vector<double> x;
   };
   const bool keep_x = static_cast<bool>(capture);
   auto one = [&](const Item& it, PearsonBank& pb) {
     StreamOut out;
+    StageClock clk;
     const double d = s.geometry.distances_m[it.di];
     const int rep = it.rep;
     const auto& train = trains[it.ti];
@@ -750,10 +758,13 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     std::vector<std::size_t> clipped;  // sample indices the input stage clipped
     const double sigma = noise_sigma(train, d);
     add_noise_and_adc(x, sigma, d, rep, train, 0, clipped);
+    out.t.channel += clk.lap();
     std::vector<double> f;
     const auto ev = lk.receive(x, lk.input_scale(), f, &out.ovf, s.noise.adc ? nullptr : &clipped);
     out.samples += x.size();
+    out.t.receiver += clk.lap();
     const auto dets = lk.detections(ev, f, 0.0, train, pb);
+    out.t.metrics += clk.lap();
     // Compensation: the reference path measures c (SceneCompensation).
     double c_est = s.receiver_speed();
     bool ref_missed = false;
@@ -767,9 +778,11 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       Link::add_into(xr, cb, 0);
       std::vector<std::size_t> rclip;
       add_noise_and_adc(xr, sigma, d, rep, train, 1, rclip);
+      out.t.channel += clk.lap();
       std::vector<double> fr;
       const auto rev = lk.receive(xr, lk.input_scale(), fr, &out.ovf);
       out.samples += xr.size();
+      out.t.receiver += clk.lap();
       const auto rdets = lk.detections(rev, fr, 0.0, {rb}, pb);
       const double rtruth = dref / lk.c() * s.fs;
       int rbest = -1;
@@ -829,6 +842,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       out.rows.push_back(m);
     }
     for (bool u : used) out.fa += !u;
+    out.t.metrics += clk.lap();  // the reference's metrics, the matching and the missed bursts' metrics
     if (keep_x) out.x = std::move(x);
     return out;
   };
@@ -844,6 +858,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     fa += o.fa;
     lk.overflows += o.ovf;
     samples_ += o.samples;
+    stage_s_ += o.t;
     if (tick) tick();
   };
   // The fixed-stream observer sees the streams in order: one thread then.
@@ -863,20 +878,13 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       const std::size_t b1 = std::min(items.size(), b0 + batch);
       std::vector<StreamOut> outs(b1 - b0);
       std::vector<std::exception_ptr> errors(b1 - b0);  // per stream: the first in stream order is thrown
-      std::atomic<std::size_t> next{b0};
-      std::vector<std::thread> pool;
-      for (std::size_t k = 0; k < jobs; ++k) {
-        pool.emplace_back([&, k] {
-          for (std::size_t i = next++; i < b1; i = next++) {
-            try {
-              outs[i - b0] = one(items[i], *banks[k]);
-            } catch (...) {
-              errors[i - b0] = std::current_exception();
-            }
-          }
-        });
-      }
-      for (auto& t : pool) t.join();
+      parallel_items(b1 - b0, jobs, [&](std::size_t i, std::size_t t) {
+        try {
+          outs[i] = one(items[b0 + i], *banks[t]);
+        } catch (...) {
+          errors[i] = std::current_exception();
+        }
+      });
       for (std::size_t i = b0; i < b1; ++i) {
         // As with one thread: the streams before a failing one are emitted, then its error.
         if (errors[i - b0]) std::rethrow_exception(errors[i - b0]);
@@ -976,39 +984,15 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     }
     std::vector<char> done(ready.size(), 0);
     const std::size_t nt = std::min(static_cast<std::size_t>(std::max(jobs_, 1)), ready.size());
-    if (nt <= 1) {
-      for (std::size_t r = 0; r < ready.size(); ++r) {
-        const auto i = ready[r];
-        done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, *lk.bank);
-      }
-    } else {
-      std::vector<std::exception_ptr> errors(ready.size());
-      std::atomic<std::size_t> at{0};
-      auto work = [&](PearsonBank& pb) {
-        for (std::size_t r = at++; r < ready.size(); r = at++) {
-          const auto i = ready[r];
-          try {
-            done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, pb);
-          } catch (...) {
-            errors[r] = std::current_exception();
-          }
-        }
-      };
-      std::vector<std::thread> pool;
-      // (without Pearson outputs the bank is not used: every thread may name lk.bank)
-      for (std::size_t t = 0; t + 1 < nt; ++t) pool.emplace_back(work, std::ref(banks.empty() ? *lk.bank : *banks[t]));
-      work(*lk.bank);
-      for (auto& t : pool) t.join();
-      for (const auto& e : errors) {
-        if (e) std::rethrow_exception(e);  // the first in burst order
-      }
-    }
-    std::vector<std::size_t> finished;
-    for (std::size_t r = 0; r < ready.size(); ++r) {
-      if (done[r]) finished.push_back(ready[r]);
-    }
-    std::sort(finished.begin(), finished.end());
-    std::erase_if(active, [&](std::size_t i) { return std::binary_search(finished.begin(), finished.end(), i); });
+    parallel_items(ready.size(), nt, [&](std::size_t r, std::size_t t) {
+      // thread 0 uses lk.bank; without Pearson outputs no bank is used and banks is empty
+      PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
+      const auto i = ready[r];
+      done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, pb);
+    });
+    // ready is a subsequence of active, in order: one pass drops the finished ones
+    std::size_t r = 0;
+    std::erase_if(active, [&](std::size_t i) { return r < ready.size() && ready[r] == i && done[r++]; });
     long keep = next < order.size() ? std::min(avail, needs[order[next]].lo) : avail;
     for (std::size_t i : active) keep = std::min(keep, needs[i].lo);
     if (static_cast<std::size_t>(keep - base) >= block && static_cast<std::size_t>(keep - base) * 2 >= w.size()) {

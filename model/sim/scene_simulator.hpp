@@ -29,6 +29,7 @@
 // range-ambiguous (aliased) distances. Input clipping (ADC or the fixed receiver's clamp) is
 // counted per measurement. With a compensation section every measurement's distance is
 // c_est * tof, c_est = d_ref / tof_ref from its reference burst (SceneCompensation).
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -38,6 +39,30 @@
 #include "model/sim/scene.hpp"
 
 namespace ranging {
+
+// Seconds per simulation stage (SceneSimulator::stage_seconds).
+struct StageSeconds {
+  double channel = 0, receiver = 0, metrics = 0;
+  StageSeconds& operator+=(const StageSeconds& o) {
+    channel += o.channel;
+    receiver += o.receiver;
+    metrics += o.metrics;
+    return *this;
+  }
+};
+// A lap timer on the steady clock: lap() returns the seconds since the last lap (or creation).
+class StageClock {
+ public:
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - t_).count();
+    t_ = now;
+    return s;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point t_ = std::chrono::steady_clock::now();
+};
 
 class CaptureSource;  // model/sim/capture_stream.hpp
 
@@ -148,6 +173,12 @@ class SceneSimulator {
   // Received samples that run() has simulated so far (every stream, compensation references
   // included; calibration not): the denominator of a per-sample speed.
   std::uint64_t samples_simulated() const { return samples_; }
+  // Seconds that run() has spent so far per stage, summed over its threads (each thread's
+  // steady clock, so on an idle core about its CPU time): channel (the clean bursts through
+  // transducers, medium and fractional delay, the streams' assembly, noise and ADC), receiver
+  // (the receiver model, and at fixed precision the float filter of the metrics), metrics (the
+  // paper's metrics, detections, matching). A speed figure, not a result: it changes run to run.
+  const StageSeconds& stage_seconds() const { return stage_s_; }
   // Number of receiver runs (streams) of run(family), for progress bars.
   std::size_t streams(const std::string& family) const;
 
@@ -194,6 +225,7 @@ class SceneSimulator {
   FixedStreamObserver observer_;
   int jobs_ = 1;
   std::uint64_t samples_ = 0;
+  StageSeconds stage_s_;
 };
 
 FamilySummary summarize(const Scene& scene, const std::string& family,
