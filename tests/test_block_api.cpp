@@ -322,3 +322,97 @@ TEST(FloatBlock, ReceiverMatchesPerSampleExecutionInChunksOfAnyLength) {
   std::vector<double> bad(3);
   EXPECT_THROW(block.execute_block(x, got, bad), InputError);
 }
+
+namespace {
+// The float bank's equations one sample at a time, with modulo indexing and plain histories
+// (the per-sample form it had before its block form): the reference of CorrelatorBankFloat.
+struct FloatBankReference {
+  const CorrelatorReference& r;
+  std::size_t n = 0;
+  double acc_re = 0, acc_im = 0, energy = 0;
+  std::vector<double> b_re, b_im, y2, bd_re, bd_im, f_re, f_im, q;
+  explicit FloatBankReference(const CorrelatorReference& ref)
+      : r(ref), b_re(static_cast<std::size_t>(ref.period)), b_im(b_re.size()), y2(static_cast<std::size_t>(ref.window)),
+        q(ref.codes.size()) {}
+  bool execute(double y) {
+    const std::size_t p = n % static_cast<std::size_t>(r.period);
+    const double w = 2.0 * std::numbers::pi * static_cast<double>(p) / r.period;
+    const double bre = y * std::cos(w), bim = -y * std::sin(w);
+    acc_re += bre - b_re[p];
+    acc_im += bim - b_im[p];
+    b_re[p] = bre;
+    b_im[p] = bim;
+    const std::size_t yi = n % y2.size();
+    energy += y * y - y2[yi];
+    y2[yi] = y * y;
+    energy = std::max(energy, 0.0);
+    ++n;
+    if (n % static_cast<std::size_t>(r.decimation) != 0) return false;
+    bd_re.push_back(acc_re);
+    bd_im.push_back(acc_im);
+    const std::size_t k = bd_re.size() - 1;
+    double fre = 0, fim = 0;
+    for (std::size_t i = 0; i < r.chip_taps.size(); ++i) {
+      fre += r.chip_taps[i] * (i <= k ? bd_re[k - i] : 0.0);
+      fim += r.chip_taps[i] * (i <= k ? bd_im[k - i] : 0.0);
+    }
+    f_re.push_back(fre);
+    f_im.push_back(fim);
+    const std::size_t step = static_cast<std::size_t>(r.chip_samples / r.decimation);
+    const std::size_t chips = r.codes.front().size();
+    for (std::size_t j = 0; j < q.size(); ++j) {
+      double cre = 0, cim = 0;
+      for (std::size_t c = 0; c < chips; ++c) {
+        const std::size_t back = (chips - 1 - c) * step;
+        const double s = r.codes[j][c] ? 1.0 : -1.0;
+        cre += s * (back <= k ? f_re[k - back] : 0.0);
+        cim += s * (back <= k ? f_im[k - back] : 0.0);
+      }
+      q[j] = (cre * cre + cim * cim) / r.code_gain[j];
+    }
+    return true;
+  }
+};
+}  // namespace
+
+TEST(FloatBlock, BankFeedMatchesItsEquationsSampleBySample) {
+  for (const char* family : {"Gold4", "M3"}) {
+    ReceiverConfig cfg;
+    cfg.family = family;
+    const ReceiverDesign d = design_receiver(cfg);
+    std::mt19937_64 rng(9);
+    std::normal_distribution<double> noise(0.0, 0.05);
+    std::vector<double> x;
+    for (const auto& t : d.templates) {
+      for (double v : t) x.push_back(v + noise(rng));
+    }
+    FloatBankReference ref(d.reference);
+    std::vector<std::vector<double>> want_q;
+    std::vector<double> want_e;
+    for (double v : x) {
+      if (ref.execute(v)) {
+        want_q.push_back(ref.q);
+        want_e.push_back(ref.energy);
+      }
+    }
+    CorrelatorBankFloat bank(d.reference);
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < x.size();) {
+      const std::size_t n = std::min<std::size_t>(x.size() - i, 1 + rng() % 300);
+      std::span<const double> rest(x.data() + i, n);
+      while (!rest.empty()) {
+        rest = rest.subspan(bank.feed(rest));
+        if (bank.output_ready()) {
+          ASSERT_LT(k, want_q.size());
+          ASSERT_EQ(bank.weighted_power(), want_q[k]) << family << " output " << k;
+          ASSERT_EQ(bank.energy(), want_e[k]) << family << " output " << k;
+          ++k;
+        }
+      }
+      i += n;
+    }
+    EXPECT_EQ(k, want_q.size());
+    EXPECT_GT(k, 100u);
+    EXPECT_EQ(bank.sample_index(), static_cast<std::int64_t>(x.size()) - 1);
+  }
+}

@@ -213,6 +213,7 @@ void CorrelatorBankFloat::reset() {
   n_ = 0;
   dec_phase_ = 0;
   acc_re_ = acc_im_ = energy_ = 0;
+  ready_ = false;
   b_re_.assign(static_cast<std::size_t>(ref_.period), 0.0);
   b_im_.assign(b_re_.size(), 0.0);
   b_idx_ = 0;
@@ -244,20 +245,53 @@ double CorrelatorBankFloat::max_corr_magnitude() const {
 }
 
 bool CorrelatorBankFloat::execute(double y) {
-  const double bre = y * lo_cos_[b_idx_], bim = -y * lo_sin_[b_idx_];
-  acc_re_ += bre - b_re_[b_idx_];
-  acc_im_ += bim - b_im_[b_idx_];
-  b_re_[b_idx_] = bre;
-  b_im_[b_idx_] = bim;
-  if (++b_idx_ == b_re_.size()) b_idx_ = 0;
-  if (++y_idx_ == y2_.size()) y_idx_ = 0;
-  energy_ += y * y - y2_[y_idx_];
-  y2_[y_idx_] = y * y;
-  energy_ = std::max(energy_, 0.0);  // running-sum rounding in double
-  ++n_;
-  if (++dec_phase_ != ref_.decimation) return false;
-  dec_phase_ = 0;
+  feed(std::span<const double>(&y, 1));
+  return ready_;
+}
 
+std::size_t CorrelatorBankFloat::feed(std::span<const double> in) {
+  const double* lo_cos = lo_cos_.data();
+  const double* lo_sin = lo_sin_.data();
+  double* b_re = b_re_.data();
+  double* b_im = b_im_.data();
+  double* y2h = y2_.data();
+  const std::size_t period = b_re_.size(), window = y2_.size();
+  const int decimation = ref_.decimation;
+  std::size_t b_idx = b_idx_, y_idx = y_idx_;
+  int dec_phase = dec_phase_;
+  double acc_re = acc_re_, acc_im = acc_im_, energy = energy_;
+  std::size_t i = 0;
+  ready_ = false;
+  while (i < in.size()) {
+    const double y = in[i++];
+    const double bre = y * lo_cos[b_idx], bim = -y * lo_sin[b_idx];
+    acc_re += bre - b_re[b_idx];
+    acc_im += bim - b_im[b_idx];
+    b_re[b_idx] = bre;
+    b_im[b_idx] = bim;
+    if (++b_idx == period) b_idx = 0;
+    if (++y_idx == window) y_idx = 0;
+    energy += y * y - y2h[y_idx];
+    y2h[y_idx] = y * y;
+    energy = std::max(energy, 0.0);  // running-sum rounding in double
+    if (++dec_phase == decimation) {
+      dec_phase = 0;
+      ready_ = true;
+      break;
+    }
+  }
+  n_ += static_cast<std::int64_t>(i);
+  b_idx_ = b_idx;
+  y_idx_ = y_idx;
+  dec_phase_ = dec_phase;
+  acc_re_ = acc_re;
+  acc_im_ = acc_im;
+  energy_ = energy;
+  if (ready_) decimated_output();
+  return i;
+}
+
+void CorrelatorBankFloat::decimated_output() {
   if (++bd_idx_ == bd_n_) bd_idx_ = 0;
   bd_re_[bd_idx_] = bd_re_[bd_idx_ + bd_n_] = acc_re_;
   bd_im_[bd_idx_] = bd_im_[bd_idx_ + bd_n_] = acc_im_;
@@ -288,7 +322,6 @@ bool CorrelatorBankFloat::execute(double y) {
     c_re_[j] = cre;
     c_im_[j] = cim;
   }
-  return true;
 }
 
 // ---------------------------------------------------------------------------------------

@@ -93,6 +93,14 @@ class CorrelatorBankFloat {
   // Feeds one filtered sample. Returns true when a decimated output was produced; then
   // weighted_power() and energy() hold its values.
   bool execute(double y);
+  // Block form: feeds y[0], y[1], ... up to and including the first sample that completes a
+  // decimated output, or to the end of y; returns how many were consumed, and output_ready()
+  // tells whether the last one completed an output. The same operations in the same order as
+  // execute() on each sample (bit for bit; the state is held in locals, which the per-sample
+  // form cannot do: its stores to the histories may alias the members); execute() is a feed
+  // of one.
+  std::size_t feed(std::span<const double> y);
+  bool output_ready() const { return ready_; }
   const std::vector<double>& weighted_power() const { return q_; }  // Q_j = P_j / K_j
   double energy() const { return energy_; }
   double rho2(int code) const { return energy_ > 0 ? q_.at(code) / energy_ : 0.0; }
@@ -120,7 +128,9 @@ class CorrelatorBankFloat {
   std::size_t bd_idx_ = 0, f_idx_ = 0, y_idx_ = 0, bd_n_ = 0, f_n_ = 0;
   int dec_phase_ = 0;
   double energy_ = 0, f_last_re_ = 0, f_last_im_ = 0;
+  bool ready_ = false;
   std::vector<double> q_, c_re_, c_im_;  // Q_j and C_j of the last output
+  void decimated_output();
 };
 
 class CorrelatorBankFixed {

@@ -257,8 +257,9 @@ std::size_t ReceiverFloat::execute_block(std::span<const double> x, std::vector<
   for (std::size_t n0 = 0; n0 < x.size(); n0 += kChunk) {
     const std::size_t len = std::min(kChunk, x.size() - n0);
     filter_.execute_block(x.subspan(n0, len), std::span<double>(y, len));
-    for (std::size_t i = 0; i < len; ++i) {
-      if (bank_.execute(y[i])) {
+    for (std::span<const double> rest(y, len); !rest.empty();) {
+      rest = rest.subspan(bank_.feed(rest));
+      if (bank_.output_ready()) {
         if (auto e = detector_.execute(bank_)) events.push_back(*e);
       }
     }
