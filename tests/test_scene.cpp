@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <memory>
 
 #include "model/base/error.hpp"
+#include "model/dsp/filter_design.hpp"
 #include "model/sim/medium.hpp"
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
@@ -184,6 +186,28 @@ TEST(Medium, SpeedOfSoundAndAbsorptionMatchPublishedValues) {
   }
   EXPECT_NEAR(20 * std::log10(std::hypot(re, im)), -absorption_db_per_m(200e3, {20, 50, 101.325}), 0.05);
   EXPECT_NEAR(im, 0.0, 1e-9);  // zero phase: no added delay
+  // The taps are the windowed inverse DFT of |H| on the 4096-point grid, as the direct sum
+  // with libm's cosine gives them (the model reduces the argument exactly through a table).
+  for (double dist : {0.1, 1.0, 7.0}) {
+    const AirConditions air{20, 50, 101.325};
+    const auto g = absorption_fir(air, dist, 5e6);
+    ASSERT_EQ(g.size() % 2, 1u);
+    const int hh = static_cast<int>(g.size() / 2);
+    const int M = 4096;
+    double peak = 0;
+    for (double v : g) peak = std::max(peak, std::abs(v));
+    for (int n = -hh; n <= hh; n += 7) {
+      double acc = std::pow(10.0, -absorption_db_per_m(0, air) * dist / 20.0);
+      for (int k = 1; k < M / 2; ++k) {
+        acc += 2.0 * std::pow(10.0, -absorption_db_per_m(5e6 * k / M, air) * dist / 20.0) *
+               std::cos(2.0 * M_PI * k * n / M);
+      }
+      acc += std::pow(10.0, -absorption_db_per_m(2.5e6, air) * dist / 20.0) * std::cos(M_PI * n);
+      const double want = acc / M * kaiser_window(static_cast<double>(n) / (hh + 1), 8.0);
+      EXPECT_NEAR(g[static_cast<std::size_t>(n + hh)], want, 1e-12 * peak) << dist << " m, tap " << n;
+      EXPECT_EQ(g[static_cast<std::size_t>(n + hh)], g[static_cast<std::size_t>(hh - n)]);
+    }
+  }
 }
 
 TEST(SimulateCli, WritesCsvAndSummaryAndPrintsStages) {

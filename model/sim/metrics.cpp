@@ -12,6 +12,7 @@
 #include <fftw3.h>
 
 #include "model/base/error.hpp"
+#include "model/sim/fft.hpp"
 
 namespace ranging {
 
@@ -42,13 +43,8 @@ LagRho pearson_over_lags(std::span<const double> x, std::span<const double> t, l
   return best;
 }
 
-// FFTW's planner is not thread-safe (only fftw_execute is): plans are made and destroyed under
-// this lock, so PearsonBanks of different threads (sweep --jobs, SceneSimulator::set_jobs) coexist.
-static std::mutex& fftw_planner_mutex() {
-  static std::mutex m;
-  return m;
-}
-
+// Plans are made and destroyed under fftw_planner_mutex() (model/sim/fft.hpp), so PearsonBanks
+// of different threads (sweep --jobs, SceneSimulator::set_jobs) coexist.
 struct PearsonBank::Plan {
   std::size_t nfft = 0;
   double* in = nullptr;

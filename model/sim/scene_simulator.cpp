@@ -15,6 +15,7 @@
 #include "model/sim/capture.hpp"
 #include "model/sim/capture_stream.hpp"
 #include "model/sim/channel.hpp"
+#include "model/sim/fft.hpp"
 #include "model/sim/front_end.hpp"
 #include "model/base/error.hpp"
 #include "model/dsp/excitation.hpp"
@@ -162,18 +163,6 @@ void through_transducers(const Scene& s, std::vector<double>& z) {
   for (double& v : z) v = rx.execute(tx.execute(v));
 }
 
-// The zero-phase absorption FIR h: z grows by h's length, and its start z0 moves back by half.
-void absorb(const std::vector<double>& h, std::vector<double>& z, long& z0) {
-  const long half = static_cast<long>(h.size() / 2);
-  std::vector<double> w(z.size() + h.size() - 1, 0.0);
-  for (std::size_t n = 0; n < z.size(); ++n) {
-    if (z[n] == 0.0) continue;
-    for (std::size_t i = 0; i < h.size(); ++i) w[n + i] += z[n] * h[i];
-  }
-  z = std::move(w);
-  z0 -= half;
-}
-
 // Spherical spreading 0.1 m / d, the sensitivity and (off axis) both pistons' directivity.
 double path_gain(const Scene& s, double d) {
   double g = s.sensitivity * kReferenceDistance / d;
@@ -181,23 +170,31 @@ double path_gain(const Scene& s, double d) {
   return g;
 }
 
-// z delayed by `shift` samples (propagate()'s fractional-delay interpolator) and scaled by g.
-Sparse delay_and_gain(const std::vector<double>& z, double shift, double g) {
+// The stages after the transducers as one FIR, per distance: the zero-phase absorption FIR
+// (when the medium is named) convolved with propagate()'s fractional-delay interpolator for
+// the whole delay d/c, scaled by the path gain; kernel[0] applies at sample `start` of a burst
+// whose z[0] is sample 0.
+struct PathKernel {
+  long start = 0;
+  std::vector<double> kernel;
+};
+PathKernel path_kernel(const Scene& s, double d, double c) {
+  std::vector<double> h{1.0};
+  long half = 0;
+  if (s.medium.air) {
+    h = absorption_fir(*s.medium.air, d, s.fs);
+    half = static_cast<long>(h.size() / 2);  // h is centred: its tap `half` is time 0
+  }
+  const double shift = d / c * s.fs - static_cast<double>(half);
   const double whole = std::floor(shift);
   const auto taps = fractional_delay_taps(shift - whole);
   constexpr long m_lo = -(kDelayTaps / 2 - 1);
-  const long I = static_cast<long>(whole);
-  Sparse out;
-  out.start = I + m_lo;
-  out.y.assign(z.size() + kDelayTaps - 1, 0.0);
-  for (std::size_t j = 0; j < z.size(); ++j) {
-    if (z[j] == 0.0) continue;
-    for (std::size_t i = 0; i < static_cast<std::size_t>(kDelayTaps); ++i) {
-      // y[k] = sum_i taps[i] z[k - I - (m_lo + i)]: for fixed j, k = I + m_lo + i + j.
-      out.y[j + i] += g * taps[i] * z[j];
-    }
-  }
-  return out;
+  PathKernel k;
+  k.start = static_cast<long>(whole) + m_lo;
+  k.kernel = convolve(h, taps);
+  const double g = path_gain(s, d);
+  for (double& v : k.kernel) v *= g;
+  return k;
 }
 
 }  // namespace
@@ -213,7 +210,7 @@ struct SceneSimulator::Link {
   std::vector<std::vector<double>> templates;   // Pearson references per code
   std::unique_ptr<PearsonBank> bank;            // their matched filter over lags
   std::map<std::pair<int, long long>, Sparse> cache;  // (code, distance in nm) -> clean burst
-  std::map<long long, std::vector<double>> fir_cache;
+  std::map<long long, PathKernel> kernel_cache;  // distance in nm -> the path's FIR
   std::uint64_t overflows = 0;
 
   double c() const { return scene->speed(); }
@@ -231,14 +228,13 @@ struct SceneSimulator::Link {
     const Scene& s = *scene;
     ExcitationParams ex{s.excitation.carrier_hz, design.config.cycles_per_chip, s.fs, s.excitation.amplitude()};
     std::vector<double> z = bpsk_excitation(design.family.codes[static_cast<std::size_t>(code - 1)], ex);
-    long z0 = 0;  // sample index of z[0]
     if (s.transducers.named) through_transducers(s, z);
-    if (s.medium.air) {
-      auto& h = fir_cache[key.second];
-      if (h.empty()) h = absorption_fir(*s.medium.air, d, s.fs);
-      absorb(h, z, z0);
-    }
-    return cache.emplace(key, delay_and_gain(z, d / c() * s.fs + static_cast<double>(z0), path_gain(s, d))).first->second;
+    auto it = kernel_cache.find(key.second);
+    if (it == kernel_cache.end()) it = kernel_cache.emplace(key.second, path_kernel(s, d, c())).first;
+    Sparse out;
+    out.start = it->second.start;
+    out.y = convolve(z, it->second.kernel);  // FFTW when both are longer than 64 samples
+    return cache.emplace(key, std::move(out)).first->second;
   }
 
   static void add_into(std::vector<double>& x, const Sparse& b, long shift) {

@@ -1,0 +1,71 @@
+// model/sim/fft.hpp: the linear convolution, direct and through FFTW, against a plain sum.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "model/sim/fft.hpp"
+
+using namespace ranging;
+
+namespace {
+std::vector<double> plain(const std::vector<double>& a, const std::vector<double>& b) {
+  std::vector<double> c(a.size() + b.size() - 1, 0.0);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = 0; j < b.size(); ++j) c[i + j] += a[i] * b[j];
+  }
+  return c;
+}
+std::vector<double> random_vector(std::size_t n, std::mt19937_64& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<double> v(n);
+  for (double& x : v) x = g(rng);
+  return v;
+}
+}  // namespace
+
+TEST(Convolve, DirectBelowTheThresholdIsThePlainSumBitForBit) {
+  std::mt19937_64 rng(1);
+  for (std::size_t nb : {1u, 2u, 17u, 64u}) {
+    auto a = random_vector(1000, rng);
+    a[10] = 0.0;  // zeros are skipped, not summed
+    const auto b = random_vector(nb, rng);
+    EXPECT_EQ(convolve(a, b), plain(a, b)) << nb;
+    EXPECT_EQ(convolve(b, a).size(), a.size() + nb - 1);
+  }
+  EXPECT_TRUE(convolve(std::vector<double>{}, std::vector<double>{1.0}).empty());
+}
+
+TEST(Convolve, FftAboveTheThresholdMatchesThePlainSumToRounding) {
+  std::mt19937_64 rng(2);
+  for (auto [na, nb] : {std::pair{65u, 65u}, std::pair{2500u, 363u}, std::pair{300u, 4000u}, std::pair{1024u, 1025u}}) {
+    const auto a = random_vector(na, rng), b = random_vector(nb, rng);
+    const auto want = plain(a, b), got = convolve(a, b);
+    ASSERT_EQ(got.size(), want.size());
+    double peak = 0, err = 0;
+    for (std::size_t k = 0; k < want.size(); ++k) {
+      peak = std::max(peak, std::abs(want[k]));
+      err = std::max(err, std::abs(got[k] - want[k]));
+    }
+    EXPECT_LT(err, 1e-13 * peak) << na << " x " << nb;
+    EXPECT_GT(err, 0.0) << "the FFT path was not taken";  // the direct sum would be exact
+  }
+}
+
+TEST(Convolve, ThreadsMayConvolveAtOnce) {
+  std::mt19937_64 rng(3);
+  const auto a = random_vector(3000, rng), b = random_vector(500, rng);
+  const auto want = convolve(a, b);
+  std::vector<std::vector<double>> got(4);
+  std::vector<std::thread> t;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    t.emplace_back([&, i] {
+      for (int r = 0; r < 20; ++r) got[i] = convolve(a, b);
+    });
+  }
+  for (auto& th : t) th.join();
+  for (const auto& g : got) EXPECT_EQ(g, want);
+}
