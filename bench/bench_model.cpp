@@ -4,7 +4,9 @@
 //   Fixed/Bandpass   BandpassFixed::execute_block (5 sections)
 //   Fixed/Bank       CorrelatorBankFixed::feed on the filtered signal
 //   Fixed/Receiver   ReceiverFixed::execute_block: bandpass + bank + detector
-//   Float/...        the same stages of the double-precision reference, per sample
+//   Float/...        the same stages of the double-precision reference, block forms
+//                    (BandpassFloat::execute_block, CorrelatorBankFloat::feed,
+//                    ReceiverFloat::execute_block: what scenes and decode run)
 // The detector's share is Receiver - Bandpass - Bank. The channel's stages:
 //   WhiteNoise      add_white_noise (Boost ziggurat + mt19937_64), the scenes' noise
 //   StdNormalNoise  std::normal_distribution + std::mt19937_64, the generator it replaced
@@ -140,8 +142,12 @@ void BM_FloatBank(benchmark::State& state) {
   CorrelatorBankFloat bank(s.d.reference);
   for (auto _ : state) {
     bank.reset();
+    std::span<const double> rest(s.filtered_float);
     std::size_t n = 0;
-    for (double v : s.filtered_float) n += bank.execute(v);
+    while (!rest.empty()) {
+      rest = rest.subspan(bank.feed(rest));
+      n += bank.output_ready();
+    }
     benchmark::DoNotOptimize(n);
   }
   items(state);
@@ -150,11 +156,12 @@ void BM_FloatBank(benchmark::State& state) {
 void BM_FloatReceiver(benchmark::State& state) {
   const Setup& s = setup();
   ReceiverFloat rx(s.d);
+  std::vector<Event> ev;
   for (auto _ : state) {
     rx.reset();
-    std::size_t n = 0;
-    for (double v : s.x) n += rx.execute(v).has_value();
-    benchmark::DoNotOptimize(n);
+    ev.clear();
+    rx.execute_block(s.x, ev);
+    benchmark::DoNotOptimize(ev.data());
   }
   items(state);
 }
