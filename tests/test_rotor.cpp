@@ -354,3 +354,35 @@ TEST(RotorDoppler, TwoCyclesPerChipRemedyDoublesTheTolerance) {
       src + "/configs/doppler-q2.yaml", Overrides{{"correlator.decimation", "10"}})));
   EXPECT_FALSE(rt10.real_time) << rt10.summary();
 }
+
+// The rotor simulator's ADC is the scenes' (model/sim/front_end.hpp): a full scale far below
+// the received bursts clips, and the run says how many samples (summary and text), where the
+// rotor's own ADC used to clip silently; a DC offset fault moves what the ADC outputs.
+TEST(RotorScene, AdcClippingIsCountedAndFaultsApply) {
+  const std::string dir = ::testing::TempDir() + "/rotor_clip_" + std::to_string(::getpid());
+  auto scene = [&](const std::string& adc) {
+    const std::string path = dir + ".yaml";
+    std::ofstream(path) << "name: clip\nmedium: {speed_of_sound: 340}\n"
+                           "transducers: {beam_angle_deg: 14.5, sensitivity: 0.165}\n"
+                           "geometry: {type: rotor, radius_m: 4.244, rpm: 60, h_m: [0.3], crossings: 1,"
+                           " window_angle_deg: 20}\n"
+                           "excitation: {family: M1, schedule: {mode: periodic, period_s: 0.00042}}\n"
+                           "noise: {noise_v: 0.005, seed: 3, adc: {" + adc + "}}\n";
+    return path;
+  };
+  auto clipped = [&](const std::string& adc, std::string* text = nullptr) {
+    const auto r = run_tool("simulate " + scene(adc) + " --out " + dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    if (text) *text = r.out;
+    std::ifstream in(dir + "/summary.json");
+    return nlohmann::json::parse(in)["adc_clipped"].get<std::uint64_t>();
+  };
+  EXPECT_EQ(clipped("bits: 12, full_scale_v: 5.0"), 0u);
+  std::string text;
+  const auto n = clipped("bits: 12, full_scale_v: 0.001", &text);
+  EXPECT_GT(n, 100u);
+  EXPECT_NE(text.find(std::to_string(n) + " ADC samples clipped"), std::string::npos) << text;
+  // A DC offset of 2 full scales puts every sample on the top rail.
+  EXPECT_GT(clipped("bits: 12, full_scale_v: 5.0, dc_offset_v: 10.0"), 1000u);
+  std::filesystem::remove_all(dir);
+}
