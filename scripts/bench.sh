@@ -3,7 +3,8 @@
 #   the golden model per stage, fixed and float (bench/bench_model), MS/s and x real time;
 #   the bandpass kernel vs scipy.signal.sosfilt on the same design and input
 #     (scripts/bench_sosfilt.py) and vs SystemC sc_fixed / sc_fix (bench/bench_fixed_point);
-#   the Verilator RTL of receiver_top vs the model (tb/bench_receiver_top);
+#   the Verilator RTL of receiver_top vs the model (tb/bench_receiver_top, then its
+#     profile-guided build tb/bench_receiver_top_pgo);
 #   streaming decode of 10 M and 100 M-sample WAV captures (/usr/bin/time -v: CPU time, peak RSS);
 #   scenes per sample: default (float, fixed, fixed without metrics) and minimal (summary.json samples_simulated);
 #   simulate --jobs 1 against --jobs 2 (wall time: the only clock that shows a parallel speedup);
@@ -29,6 +30,13 @@ trap 'rm -rf "$T"' EXIT
 $PY scripts/bench_sosfilt.py "$T/sos.json" >"$T/sosfilt.txt"
 if [[ -x $B/tb/bench_receiver_top ]]; then
   "$B"/tb/bench_receiver_top 2 >"$T/rtl.txt"
+  # The profile-guided build of the same bench (tb/bench.cmake; a sub-build in $B/bench-pgo,
+  # a few minutes the first time); when it cannot be built the plain figures stand alone.
+  if cmake --build "$B" --target bench_receiver_top_pgo >"$T/pgo.log" 2>&1; then
+    { echo; "$B"/tb/bench_receiver_top_pgo 2; } >>"$T/rtl.txt"
+  else
+    { echo; echo "bench_receiver_top_pgo: not built (last lines of its build):"; tail -n 3 "$T/pgo.log"; } >>"$T/rtl.txt"
+  fi
 else
   echo "not built (configure with -DRANGING_BUILD_HARDWARE=ON)" >"$T/rtl.txt"
 fi

@@ -12,3 +12,50 @@ verilate(bench_receiver_top SOURCES ${RANGING_GEN_DEFAULT}/rtl/receiver_top.v
   # Bench build only (the equivalence testbenches keep their settings): X values resolved once
   # at compile time and initial values not randomized (scripts/bench.sh measures the choice).
   VERILATOR_ARGS -Wno-fatal -O3 --x-assign fast --x-initial fast)
+
+# Profile-guided build of the same bench (docs/results/speed.md, "Verilator RTL"):
+#   cmake --build build --target bench_receiver_top_pgo   ->  build/tb/bench_receiver_top_pgo
+# scripts/bench_pgo.cmake configures a sub-build (build/bench-pgo/) of this project with
+# RANGING_BENCH_PGO=generate, runs the instrumented bench briefly, then rebuilds it with
+# RANGING_BENCH_PGO=use. Compiler: clang++ with LTO when clang++ and a matching llvm-profdata
+# are found (the fastest measured), else this build's compiler (GCC PGO + LTO). Not part of
+# `all` (the test build and CI never pay for it); on failure the plain bench_receiver_top
+# stays (scripts/bench.sh falls back to it).
+set(RANGING_BENCH_PGO "" CACHE STRING "Set by scripts/bench_pgo.cmake only: generate or use")
+set(RANGING_BENCH_PGO_PROFILE "" CACHE FILEPATH "Set by scripts/bench_pgo.cmake only: merged clang profile")
+set(bench_build "${CMAKE_CXX_COMPILER_ID} ${CMAKE_CXX_COMPILER_VERSION}")
+if(RANGING_BENCH_PGO)
+  # Every source of the target (the bench, the Verilated model, the Verilator runtime) is
+  # instrumented and then optimized; the model libraries are built plainly.
+  set(pgo_opts -flto)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    if(RANGING_BENCH_PGO STREQUAL "generate")
+      list(APPEND pgo_opts -fprofile-instr-generate)
+    else()
+      list(APPEND pgo_opts -fprofile-instr-use=${RANGING_BENCH_PGO_PROFILE} -Wno-profile-instr-unprofiled
+           -Wno-profile-instr-out-of-date)
+    endif()
+  else()  # GCC: the .gcda files sit beside the objects (same sub-build, same object paths)
+    if(RANGING_BENCH_PGO STREQUAL "generate")
+      list(APPEND pgo_opts -fprofile-generate -fprofile-update=single)
+    else()
+      list(APPEND pgo_opts -fprofile-use -fprofile-partial-training -Wno-missing-profile)
+    endif()
+  endif()
+  target_compile_options(bench_receiver_top PRIVATE ${pgo_opts})
+  target_link_options(bench_receiver_top PRIVATE ${pgo_opts})
+  string(APPEND bench_build ", LTO, profile-guided (${RANGING_BENCH_PGO})")
+else()
+  find_program(RANGING_BENCH_PGO_CXX NAMES clang++ DOC "Compiler of bench_receiver_top_pgo (clang++ if found)")
+  set(pgo_bin ${CMAKE_CURRENT_BINARY_DIR}/bench_receiver_top_pgo)
+  add_custom_command(OUTPUT ${pgo_bin}
+    COMMAND ${CMAKE_COMMAND} -DSOURCE_DIR=${PROJECT_SOURCE_DIR} -DWORK_DIR=${CMAKE_BINARY_DIR}/bench-pgo
+            -DOUTPUT=${pgo_bin} -DCLANG_CXX=${RANGING_BENCH_PGO_CXX} -DDEFAULT_CXX=${CMAKE_CXX_COMPILER}
+            -P ${PROJECT_SOURCE_DIR}/scripts/bench_pgo.cmake
+    # the plain bench first: it rebuilds (and so this reruns) whenever the model, RTL or bench change
+    DEPENDS bench_receiver_top ${PROJECT_SOURCE_DIR}/scripts/bench_pgo.cmake ${CMAKE_CURRENT_SOURCE_DIR}/bench.cmake
+    COMMENT "bench_receiver_top_pgo: instrumented build, training run, optimized build (scripts/bench_pgo.cmake)"
+    USES_TERMINAL VERBATIM)
+  add_custom_target(bench_receiver_top_pgo DEPENDS ${pgo_bin})
+endif()
+target_compile_definitions(bench_receiver_top PRIVATE RANGING_BENCH_BUILD="${bench_build}")

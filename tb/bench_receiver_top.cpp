@@ -19,6 +19,10 @@
 
 using namespace ranging;
 
+#ifndef RANGING_BENCH_BUILD
+#define RANGING_BENCH_BUILD "unknown compiler"
+#endif
+
 namespace {
 double cpu_seconds() {  // CPU time of this thread: per-core figures on a shared machine
   timespec ts{};
@@ -123,6 +127,7 @@ int main(int argc, char** argv) {
   const double fs = d.config.fs;
   std::printf("receiver_top (default configuration, %s), samples per second of CPU time (one core):\n",
               d.family.name.c_str());
+  std::printf("  (bench build: %s)\n", RANGING_BENCH_BUILD);
   std::printf("  golden model ReceiverFixed, block API: %12.0f samples/s  (%.1f x real time at %.0f MS/s)\n",
               block_rate, block_rate / fs, fs / 1e6);
   std::printf("  golden model ReceiverFixed, per sample:%12.0f samples/s  (%.1f x real time)\n", sample_rate,
