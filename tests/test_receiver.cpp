@@ -164,3 +164,38 @@ TEST(ReceiverConfig, FitDecimationToChipPicksTheLargestDivisor) {
   fit_decimation_to_chip(cfg);
   EXPECT_EQ(cfg.decimation, 25);
 }
+
+// The demo's rows (distance x code) on several threads: every field identical to one thread's,
+// whatever the number of threads (each row has its own seed and slot); the tool's --jobs too.
+TEST(Demo, SeveralThreadsGiveTheSameRows) {
+  DemoParams p;
+  p.distances_m = {0.1, 0.37, 0.8};
+  p.noise_rms = 0.02;
+  const auto one = run_demo(p);
+  for (int jobs : {2, 5}) {
+    p.jobs = jobs;
+    std::size_t calls = 0;
+    const auto many = run_demo(p, [&](std::size_t, std::size_t) { ++calls; });
+    ASSERT_EQ(many.size(), one.size());
+    EXPECT_EQ(calls, one.size() + 9);  // the 9 calibration bursts, then every row once
+    for (std::size_t i = 0; i < one.size(); ++i) {
+      const auto &a = one[i], &b = many[i];
+      EXPECT_EQ(a.code, b.code);
+      EXPECT_EQ(a.distance_m, b.distance_m);
+      EXPECT_EQ(a.flt.tof_s, b.flt.tof_s);
+      EXPECT_EQ(a.fix.tof_s, b.fix.tof_s);
+      EXPECT_EQ(a.fix.score, b.fix.score);
+      EXPECT_EQ(a.rho_max, b.rho_max);
+      EXPECT_EQ(a.u, b.u);
+      EXPECT_EQ(a.energy, b.energy);
+      EXPECT_EQ(a.overflows, b.overflows);
+    }
+  }
+  p.jobs = 0;
+  EXPECT_THROW(run_demo(p), InputError);
+  const auto r1 = run_tool("demo --json --distances 0.2,0.6");
+  const auto r2 = run_tool("demo --json --distances 0.2,0.6 --jobs 2");
+  ASSERT_EQ(r1.status, 0) << r1.err;
+  ASSERT_EQ(r2.status, 0) << r2.err;
+  EXPECT_EQ(r1.out, r2.out);
+}

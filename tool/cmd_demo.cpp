@@ -26,6 +26,7 @@ int cmd_demo(const Args& args) {
   p.option("--noise-rms", "FS", "white noise rms at the ADC in full-scale units, 0..10", "0.002");
   p.option("--seed", "N", "noise seed", "1");
   add_output_options(p, {.json = true, .quiet = true});
+  add_jobs_option(p, "rows (distance x code) simulated");
   if (!p.parse(args)) return 0;
 
   DemoParams d;
@@ -36,6 +37,7 @@ int cmd_demo(const Args& args) {
   d.gain = p.number("--gain", 0.5, 1e-6, 10);
   d.noise_rms = p.number("--noise-rms", 0.002, 0, 10);
   d.seed = static_cast<std::uint64_t>(p.integer("--seed", 1, 0, 1LL << 62));
+  d.jobs = jobs_option(p);
   const bool json = p.has("--json");
   // Progress only where a person watches it.
   const bool quiet = p.has("--quiet") || json || !isatty(STDERR_FILENO);

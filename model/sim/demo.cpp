@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <mutex>
 
 #include "model/base/error.hpp"
+#include "model/base/parallel.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/latency.hpp"
 #include "model/sim/metrics.hpp"
@@ -60,6 +63,7 @@ std::vector<DemoRow> run_demo(const DemoParams& p,
   require_in_range("--gain", p.gain, 1e-6, 10);
   require_in_range("--noise-rms", p.noise_rms, 0, 10);
   if (p.distances_m.empty()) throw InputError("--distances: give at least one distance");
+  require_in_range("--jobs", p.jobs, 1, 256);
   for (double d : p.distances_m) require_in_range("--distances", d, 0.01, 20.0);
 
   const ReceiverDesign design = design_receiver(p.receiver);
@@ -106,14 +110,21 @@ std::vector<DemoRow> run_demo(const DemoParams& p,
   }
   cal.clear();
 
-  PearsonBank bank(templates);
-  std::vector<DemoRow> rows;
-  std::uint64_t seed = p.seed;
-  for (double d : p.distances_m) {
-    for (std::size_t j = 0; j < eta; ++j) {
+  // The rows (distance x code) are independent: each is drawn from its own seed (p.seed + 1 +
+  // its index) and written to its own slot, on p.jobs threads with a matched filter each.
+  const std::size_t threads = std::min<std::size_t>(static_cast<std::size_t>(p.jobs), p.distances_m.size() * eta);
+  std::vector<std::unique_ptr<PearsonBank>> banks;
+  for (std::size_t t = 0; t < std::max<std::size_t>(threads, 1); ++t) banks.push_back(std::make_unique<PearsonBank>(templates));
+  std::vector<DemoRow> rows(p.distances_m.size() * eta);
+  std::mutex progress_lock;
+  parallel_items(rows.size(), threads, [&](std::size_t item, std::size_t t) {
+    PearsonBank& bank = *banks[t];
+    const double d = p.distances_m[item / eta];
+    const std::size_t j = item % eta;
+    {
       const auto exc = bpsk_excitation(design.family.codes[j], ex);
       const double delay = d / p.speed_of_sound * rc.fs;
-      const auto rx = propagate(exc, channel_for(p, d, p.noise_rms, ++seed), rc.fs,
+      const auto rx = propagate(exc, channel_for(p, d, p.noise_rms, p.seed + 1 + item), rc.fs,
                                 static_cast<std::size_t>(delay) + tail);
       Pass pass = run_receivers(design, rx);
       DemoRow row;
@@ -152,10 +163,13 @@ std::vector<DemoRow> run_demo(const DemoParams& p,
       if (start >= 0 && static_cast<std::size_t>(start) + template_len <= pass.filtered.size()) {
         row.energy = energy(std::span<const double>(pass.filtered.data() + start, template_len));
       }
-      rows.push_back(row);
-      if (progress) progress(++done, total);
+      rows[item] = row;
+      if (progress) {
+        const std::lock_guard<std::mutex> lock(progress_lock);
+        progress(++done, total);
+      }
     }
-  }
+  });
   return rows;
 }
 

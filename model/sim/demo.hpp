@@ -26,6 +26,7 @@ struct DemoParams {
   double noise_rms = 0.002;   // white noise at the ADC input, full-scale units (0: none)
   std::uint64_t seed = 1;
   TransducerParams transducer;                    // TX and RX
+  int jobs = 1;               // threads for the rows (distance x code); the rows do not depend on it
 };
 
 struct DemoDecode {

@@ -18,6 +18,7 @@
 #include "model/sim/fft.hpp"
 #include "model/sim/front_end.hpp"
 #include "model/base/error.hpp"
+#include "model/base/parallel.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/latency.hpp"
 #include "model/sim/metrics.hpp"
@@ -604,31 +605,6 @@ SceneSimulator::Link& SceneSimulator::link(const std::string& family) {
 }
 
 namespace {
-// f(i, t) for every i in [0, n) on `threads` threads (t: the thread's index; thread 0 is the
-// caller), items handed out in order. An exception of f is kept per item; once every thread has
-// joined, the first in item order is rethrown.
-template <class F>
-void parallel_items(std::size_t n, std::size_t threads, F f) {
-  std::vector<std::exception_ptr> errors(n);
-  std::atomic<std::size_t> next{0};
-  auto work = [&](std::size_t t) {
-    for (std::size_t i = next++; i < n; i = next++) {
-      try {
-        f(i, t);
-      } catch (...) {
-        errors[i] = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work, t);
-  work(0);
-  for (auto& t : pool) t.join();
-  for (const auto& e : errors) {
-    if (e) std::rethrow_exception(e);
-  }
-}
-
 std::vector<int> codes_sent(const Scene& s, int eta) {
   std::vector<int> codes = s.excitation.codes;
   if (codes.empty()) {
