@@ -173,8 +173,8 @@ void check_yaml_text(const std::string& text, const std::string& origin) {
       ++i;
       continue;
     }
-    std::size_t len;
-    std::uint32_t cp;
+    std::size_t len = 1;  // every branch below sets it or throws (bad)
+    std::uint32_t cp = 0;
     if (c >= 0xC2 && c <= 0xDF) {
       len = 2, cp = c & 0x1Fu;
     } else if (c >= 0xE0 && c <= 0xEF) {
