@@ -8,6 +8,7 @@
 
 #include "model/base/error.hpp"
 #include "model/dsp/filter_design.hpp"
+#include "model/sim/fft.hpp"
 #include "model/sim/front_end.hpp"
 
 namespace ranging {
@@ -70,13 +71,12 @@ std::vector<double> propagate(std::span<const double> excitation, const ChannelP
       z[j] = rx.execute(tx.execute(x));
     }
     const double g = p.gain * kReferenceDistance / p.distance_m;
+    // y[k] = g sum_i taps[i] z[k - I - m_lo - i] = g (z * taps)[k - I - m_lo]: the linear
+    // convolution (model/sim/fft.hpp, the direct sum at 64 taps), z[j] = 0 outside [0, z_len).
+    const std::vector<double> c = convolve(z, taps);
     for (std::size_t k = 0; k < n_out; ++k) {
-      double acc = 0.0;
-      for (std::ptrdiff_t i = 0; i < kDelayTaps; ++i) {
-        const std::ptrdiff_t j = static_cast<std::ptrdiff_t>(k) - I - (m_lo + i);
-        if (j >= 0 && j < z_len) acc += taps[static_cast<std::size_t>(i)] * z[static_cast<std::size_t>(j)];
-      }
-      y[k] = g * acc;
+      const std::ptrdiff_t m = static_cast<std::ptrdiff_t>(k) - I - m_lo;
+      if (m >= 0 && m < static_cast<std::ptrdiff_t>(c.size())) y[k] = g * c[static_cast<std::size_t>(m)];
     }
   }
   add_white_noise(y, p.noise_rms, p.seed);
