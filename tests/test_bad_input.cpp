@@ -134,6 +134,11 @@ std::vector<Case> catalogue() {
       {"filter type", {}, "filter --type bogus", {"--type", "butter"}},
       {"precision", {{"s.yaml", kScene}}, sim + " --precision double", {"--precision", "valid: float, fixed"}},
       {"missing positional", {}, "simulate", {"missing argument SCENE"}},
+      {"simulate --timing of a rotor scene",
+       {{"r.yaml", "name: r\ngeometry: {type: rotor, radius_m: 4.244, rpm: 60, h_m: [0.3], crossings: 1}\n"
+                   "excitation: {family: M1, schedule: {mode: periodic, period_s: 0.00042}}\n"}},
+       "simulate {d}/r.yaml --quiet --out {d}/out --timing", {"--timing", "not available for rotor scenes"}},
+      {"demo --jobs 0", {}, "demo --jobs 0", {"--jobs", "[1, 256]"}},
       {"decode without family", {{"x.csv", csv_capture(50)}}, "decode {d}/x.csv", {"--family", "required"}},
       {"decode min-rho out of range", {{"x.csv", csv_capture(50)}}, dec + "{d}/x.csv --min-rho 2",
        {"--min-rho", "[0, 1]"}},
