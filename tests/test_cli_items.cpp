@@ -153,3 +153,22 @@ TEST(CliItems, EvaluateWithoutOutWritesUnderOutNotDocs) {
   EXPECT_FALSE(fs::exists(cwd / "docs"));
   fs::remove_all(cwd);
 }
+
+// Every command's --help: below "options:" (and "arguments:"), a line is an option or positional
+// name (2 spaces) or a help text indented 6 spaces, its continuation lines too.
+TEST(CliItems, HelpTextsAreIndentedUnderTheirOptions) {
+  for (const char* c : {"simulate", "decode", "demo", "sweep", "verify", "generate", "bitstream", "evaluate"}) {
+    const auto r = run_tool(std::string(c) + " --help");
+    ASSERT_EQ(r.status, 0) << c;
+    const auto at = r.out.find("\noptions:\n");
+    ASSERT_NE(at, std::string::npos) << c;
+    std::istringstream in(r.out.substr(at + 10));
+    std::size_t lines = 0;
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty()) continue;
+      ++lines;
+      EXPECT_TRUE(line.rfind("  --", 0) == 0 || line.rfind("      ", 0) == 0) << c << ": '" << line << "'";
+    }
+    EXPECT_GT(lines, 4u) << c;
+  }
+}

@@ -36,6 +36,18 @@ const Parser::Opt* Parser::find(const std::string& name) const {
   return nullptr;
 }
 
+namespace {
+// A help text under its option: every line indented 6 spaces, the continuation lines too.
+std::string indented(const std::string& text) {
+  std::string out = "      ";
+  for (char c : text) {
+    out += c;
+    if (c == '\n') out += "      ";
+  }
+  return out;
+}
+}  // namespace
+
 std::string Parser::help_text() const {
   std::ostringstream os;
   os << "usage: " << usage_;
@@ -43,13 +55,13 @@ std::string Parser::help_text() const {
   os << " [options]\n\n" << description_ << "\n";
   if (!pos_.empty()) {
     os << "\narguments:\n";
-    for (const Pos& p : pos_) os << "  " << p.metavar << "\n      " << p.help << "\n";
+    for (const Pos& p : pos_) os << "  " << p.metavar << "\n" << indented(p.help) << "\n";
   }
   os << "\noptions:\n";
   for (const Opt& o : opts_) {
     os << "  " << o.name;
     if (o.takes_value) os << " " << o.metavar;
-    os << "\n      " << o.help;
+    os << "\n" << indented(o.help);
     if (o.default_value) os << " (default: " << *o.default_value << ")";
     os << "\n";
   }
