@@ -352,3 +352,26 @@ TEST(SceneMetrics, SimulateMarksWhatItDidNotComputeAndEvaluateRefusesIt) {
   std::filesystem::remove_all(dir);
   std::filesystem::remove_all(dir + "_t");
 }
+
+// simulate --timing: summary.json carries the seconds per stage (each >= 0; the default scene
+// spends time in all three), and only when asked (the summary is otherwise reproducible).
+TEST(SimulateCli, TimingRecordsTheSecondsPerStageOnlyWhenAsked) {
+  const std::string dir = ::testing::TempDir() + "/sim_timing_" + std::to_string(::getpid());
+  const std::string scene = std::string(RANGING_SOURCE_DIR) + "/scenes/default.yaml";
+  const ToolRun t = run_tool("simulate " + scene + " --quiet --timing --out " + dir);
+  ASSERT_EQ(t.status, 0) << t.out;
+  {
+    std::ifstream js(dir + "/summary.json");
+    const auto j = nlohmann::json::parse(js);
+    ASSERT_TRUE(j.contains("stage_seconds"));
+    for (const char* k : {"channel", "receiver", "metrics"}) {
+      ASSERT_TRUE(j["stage_seconds"].contains(k)) << k;
+      EXPECT_GT(j["stage_seconds"][k].get<double>(), 0.0) << k;
+    }
+  }
+  const ToolRun n = run_tool("simulate " + scene + " --quiet --out " + dir);
+  ASSERT_EQ(n.status, 0) << n.out;
+  std::ifstream js(dir + "/summary.json");
+  EXPECT_FALSE(nlohmann::json::parse(js).contains("stage_seconds"));
+  std::filesystem::remove_all(dir);
+}
