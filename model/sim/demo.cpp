@@ -114,60 +114,58 @@ std::vector<DemoRow> run_demo(const DemoParams& p,
   // its index) and written to its own slot, on p.jobs threads with a matched filter each.
   const std::size_t threads = std::min<std::size_t>(static_cast<std::size_t>(p.jobs), p.distances_m.size() * eta);
   std::vector<std::unique_ptr<PearsonBank>> banks;
-  for (std::size_t t = 0; t < std::max<std::size_t>(threads, 1); ++t) banks.push_back(std::make_unique<PearsonBank>(templates));
+  for (std::size_t t = 0; t < threads; ++t) banks.push_back(std::make_unique<PearsonBank>(templates));
   std::vector<DemoRow> rows(p.distances_m.size() * eta);
   std::mutex progress_lock;
   parallel_items(rows.size(), threads, [&](std::size_t item, std::size_t t) {
     PearsonBank& bank = *banks[t];
     const double d = p.distances_m[item / eta];
     const std::size_t j = item % eta;
-    {
-      const auto exc = bpsk_excitation(design.family.codes[j], ex);
-      const double delay = d / p.speed_of_sound * rc.fs;
-      const auto rx = propagate(exc, channel_for(p, d, p.noise_rms, p.seed + 1 + item), rc.fs,
-                                static_cast<std::size_t>(delay) + tail);
-      Pass pass = run_receivers(design, rx);
-      DemoRow row;
-      row.code = static_cast<int>(j) + 1;
-      row.distance_m = d;
-      row.overflows = pass.overflows;
-      auto fill = [&](DemoDecode& out, const std::optional<Event>& e,
-                      const std::vector<double>& offsets) {
-        if (!e) return;
-        out.detected = true;
-        out.decoded = e->code;
-        out.tof_s = (e->arrival - offsets[e->code - 1]) / rc.fs;
-        out.distance_m = out.tof_s * p.speed_of_sound;
-        out.error_m = out.distance_m - d;
-        out.score = e->score;
-        out.margin = e->margin;
-      };
-      fill(row.flt, pass.flt, offset_flt);
-      fill(row.fix, pass.fix, offset_fix);
-      // The paper's decoder: the Pearson matched filter (eq. 9 over lags, +-L chips around the
-      // float receiver's time of flight, or the true one if nothing was found); u by eq. 10.
-      const double tof_samples = row.flt.detected ? row.flt.tof_s * rc.fs : delay;
-      const long start = std::lround(tof_samples);
-      const long reach = static_cast<long>(window);
-      const long n = static_cast<long>(pass.filtered.size());
-      if (start - reach <= n - static_cast<long>(template_len) && start + reach >= 0) {
-        const auto best = bank.search(pass.filtered, start - reach, start + reach);
-        std::vector<double> rhos;
-        for (const auto& b : best) rhos.push_back(b.rho);
-        const Distinguishability dist = distinguishability(rhos);
-        row.pearson_decoded = dist.best_code;
-        row.rho_max = dist.rho_max;
-        row.rho_submax = dist.rho_submax;
-        row.u = u_for_sent(rhos, row.code);
-      }
-      if (start >= 0 && static_cast<std::size_t>(start) + template_len <= pass.filtered.size()) {
-        row.energy = energy(std::span<const double>(pass.filtered.data() + start, template_len));
-      }
-      rows[item] = row;
-      if (progress) {
-        const std::lock_guard<std::mutex> lock(progress_lock);
-        progress(++done, total);
-      }
+    const auto exc = bpsk_excitation(design.family.codes[j], ex);
+    const double delay = d / p.speed_of_sound * rc.fs;
+    const auto rx = propagate(exc, channel_for(p, d, p.noise_rms, p.seed + 1 + item), rc.fs,
+                              static_cast<std::size_t>(delay) + tail);
+    Pass pass = run_receivers(design, rx);
+    DemoRow row;
+    row.code = static_cast<int>(j) + 1;
+    row.distance_m = d;
+    row.overflows = pass.overflows;
+    auto fill = [&](DemoDecode& out, const std::optional<Event>& e,
+                    const std::vector<double>& offsets) {
+      if (!e) return;
+      out.detected = true;
+      out.decoded = e->code;
+      out.tof_s = (e->arrival - offsets[e->code - 1]) / rc.fs;
+      out.distance_m = out.tof_s * p.speed_of_sound;
+      out.error_m = out.distance_m - d;
+      out.score = e->score;
+      out.margin = e->margin;
+    };
+    fill(row.flt, pass.flt, offset_flt);
+    fill(row.fix, pass.fix, offset_fix);
+    // The paper's decoder: the Pearson matched filter (eq. 9 over lags, +-L chips around the
+    // float receiver's time of flight, or the true one if nothing was found); u by eq. 10.
+    const double tof_samples = row.flt.detected ? row.flt.tof_s * rc.fs : delay;
+    const long start = std::lround(tof_samples);
+    const long reach = static_cast<long>(window);
+    const long n = static_cast<long>(pass.filtered.size());
+    if (start - reach <= n - static_cast<long>(template_len) && start + reach >= 0) {
+      const auto best = bank.search(pass.filtered, start - reach, start + reach);
+      std::vector<double> rhos;
+      for (const auto& b : best) rhos.push_back(b.rho);
+      const Distinguishability dist = distinguishability(rhos);
+      row.pearson_decoded = dist.best_code;
+      row.rho_max = dist.rho_max;
+      row.rho_submax = dist.rho_submax;
+      row.u = u_for_sent(rhos, row.code);
+    }
+    if (start >= 0 && static_cast<std::size_t>(start) + template_len <= pass.filtered.size()) {
+      row.energy = energy(std::span<const double>(pass.filtered.data() + start, template_len));
+    }
+    rows[item] = row;
+    if (progress) {
+      const std::lock_guard<std::mutex> lock(progress_lock);
+      progress(++done, total);
     }
   });
   return rows;

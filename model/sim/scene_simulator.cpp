@@ -1,6 +1,7 @@
 #include "model/sim/scene_simulator.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <atomic>
 #include <exception>
 #include <cmath>
@@ -51,6 +52,20 @@ double near_field_m(const Scene& s) {
                    lambda / (2.0 * std::numbers::pi);
   return a * a / lambda;
 }
+
+// A lap timer on the steady clock: lap() returns the seconds since the last lap (or creation).
+class StageClock {
+ public:
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - t_).count();
+    t_ = now;
+    return s;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point t_ = std::chrono::steady_clock::now();
+};
 
 std::uint64_t splitmix(std::uint64_t x) {
   x += 0x9E3779B97F4A7C15ull;

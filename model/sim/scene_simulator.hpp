@@ -29,7 +29,6 @@
 // range-ambiguous (aliased) distances. Input clipping (ADC or the fixed receiver's clamp) is
 // counted per measurement. With a compensation section every measurement's distance is
 // c_est * tof, c_est = d_ref / tof_ref from its reference burst (SceneCompensation).
-#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -49,19 +48,6 @@ struct StageSeconds {
     metrics += o.metrics;
     return *this;
   }
-};
-// A lap timer on the steady clock: lap() returns the seconds since the last lap (or creation).
-class StageClock {
- public:
-  double lap() {
-    const auto now = std::chrono::steady_clock::now();
-    const double s = std::chrono::duration<double>(now - t_).count();
-    t_ = now;
-    return s;
-  }
-
- private:
-  std::chrono::steady_clock::time_point t_ = std::chrono::steady_clock::now();
 };
 
 class CaptureSource;  // model/sim/capture_stream.hpp
