@@ -53,8 +53,9 @@ TEST(Capture, CsvAndWavRoundTripInEveryFormat) {
   EXPECT_EQ(csv.t0, 0.0);
   ASSERT_EQ(csv.samples.size(), c.samples.size());
   for (std::size_t n = 0; n < c.samples.size(); ++n) EXPECT_NEAR(csv.samples[n], c.samples[n], 1e-9);
-  for (auto [fmt, tol] : {std::pair{WavFormat::Pcm16, 1.0 / 32768}, std::pair{WavFormat::Pcm24, 1.0 / 8388608},
-                          std::pair{WavFormat::Float32, 1e-7}}) {
+  for (auto [fmt, tol] : {std::pair{WavFormat::Pcm8, 1.0 / 256}, std::pair{WavFormat::Pcm16, 1.0 / 65536},
+                          std::pair{WavFormat::Pcm24, 1.0 / 16777216}, std::pair{WavFormat::Pcm32, 1.0 / 4294967296.0},
+                          std::pair{WavFormat::Float32, 1e-7}, std::pair{WavFormat::Float64, 0.0}}) {
     const Capture w = parse_capture_wav(capture_wav(c, fmt), "x.wav");
     EXPECT_EQ(w.sample_rate, 5e6);
     ASSERT_EQ(w.samples.size(), c.samples.size());
@@ -106,9 +107,43 @@ TEST(Capture, BadWavIsRefusedWithByteOffset) {
   EXPECT_NE(err(good.substr(0, 30)).find("truncated"), std::string::npos);
   EXPECT_NE(err("").find("empty"), std::string::npos);
   EXPECT_NE(err("RIFX0000WAVE").find("not a RIFF/WAVE"), std::string::npos);
-  std::string bits8 = good;
-  bits8[34] = 8;  // bits per sample
-  EXPECT_NE(err(bits8).find("unsupported sample format"), std::string::npos);
+  std::string bits12 = good;
+  bits12[34] = 12;  // bits per sample
+  EXPECT_NE(err(bits12).find("cap.wav: byte 36: unsupported sample format (format 1, 12 bits); valid: 8/16/24/32-bit "
+                             "PCM, 32/64-bit float"),
+            std::string::npos)
+      << err(bits12);
+  std::string alaw = good;
+  alaw[20] = 6;  // format 6 (A-law)
+  EXPECT_NE(err(alaw).find("unsupported sample format (format 6"), std::string::npos);
+  // a NaN in a 64-bit float WAV names its sample and byte
+  c.samples[7] = std::nan("");
+  EXPECT_NE(err(capture_wav(c, WavFormat::Float64)).find("cap.wav: byte 100: sample 7 is not finite"), std::string::npos)
+      << err(capture_wav(c, WavFormat::Float64));
+}
+
+// The codes of each format, as scipy.io.wavfile and other tools write them (little-endian,
+// 8-bit unsigned with 128 as zero), read back as full-scale fractions.
+TEST(Capture, WavPcmCodesAreFullScaleFractionsInEveryWidth) {
+  Capture c;
+  c.sample_rate = 2e6;
+  c.samples = {0.0, 0.5, -0.5, -1.0, 127.0 / 128.0};
+  const std::string w8 = capture_wav(c, WavFormat::Pcm8);
+  ASSERT_EQ(w8.size(), 44u + 5u);
+  EXPECT_EQ(static_cast<unsigned char>(w8[44]), 128);  // 0
+  EXPECT_EQ(static_cast<unsigned char>(w8[45]), 192);  // 0.5
+  EXPECT_EQ(static_cast<unsigned char>(w8[46]), 64);   // -0.5
+  EXPECT_EQ(static_cast<unsigned char>(w8[47]), 0);    // -1
+  EXPECT_EQ(static_cast<unsigned char>(w8[48]), 255);  // 127/128
+  const std::string w32 = capture_wav(c, WavFormat::Pcm32);
+  ASSERT_EQ(w32.size(), 44u + 20u);
+  EXPECT_EQ(w32.substr(48, 4), std::string("\x00\x00\x00\x40", 4));  // 0.5 = 2^30
+  EXPECT_EQ(w32.substr(56, 4), std::string("\x00\x00\x00\x80", 4));  // -1 = -2^31
+  for (WavFormat f : {WavFormat::Pcm8, WavFormat::Pcm32, WavFormat::Float64}) {
+    const Capture r = parse_capture_wav(capture_wav(c, f), "x.wav");
+    ASSERT_EQ(r.samples.size(), c.samples.size());
+    for (std::size_t i = 0; i < c.samples.size(); ++i) EXPECT_EQ(r.samples[i], c.samples[i]) << i;
+  }
 }
 
 // simulate --write-captures, then decode every capture back: same code, same distance.

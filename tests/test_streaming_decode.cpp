@@ -142,6 +142,10 @@ TEST(StreamingDecode, SeveralThreadsGiveTheSameDetections) {
 
 TEST(StreamingDecode, Pcm16WavAndCsvEqualWholeFile) {
   check_file(write("train16.wav", capture_wav(capture(), WavFormat::Pcm16, 0.5)), "fixed");
+  // the formats other simulators write (numpy int32 / float64, 8-bit audio)
+  check_file(write("train32.wav", capture_wav(capture(), WavFormat::Pcm32, 0.5)), "fixed");
+  check_file(write("train64.wav", capture_wav(capture(), WavFormat::Float64)), "float");
+  check_file(write("train8.wav", capture_wav(capture(), WavFormat::Pcm8, 0.5)), "float");
   Capture c = capture();
   c.t0 = -2e-5;  // a scope's pre-trigger
   check_file(write("train.csv", capture_csv(c)), "float");

@@ -40,7 +40,7 @@ constexpr Command kCommands[] = {
      "generated Markdown document comparing the paper's values with ours."},
     {"decode", cmd_decode, "decode a recorded capture (oscilloscope CSV or WAV)",
      "Decode a capture: oscilloscope CSV (header lines, then rows 'time_s,volts') or WAV\n"
-     "(16/24-bit PCM, 32-bit float), t = 0 at the start of transmission of the first\n"
+     "(8/16/24/32-bit PCM, 32/64-bit float), t = 0 at the start of transmission of the first\n"
      "burst. The receiver (bandpass, correlator bank, peak detector) adapts to the file's\n"
      "sample rate (it must be an integer multiple of the 200 kHz carrier); its latency and\n"
      "the Pearson references are simulated with the calibrated transducers (docs/scenes.md)\n"

@@ -297,11 +297,11 @@ WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::siz
       if (!have_fmt) fail_wav(origin, at, "data chunk before the fmt chunk");
       if (channels == 0) fail_wav(origin, at, "fmt declares 0 channels");
       if (rate == 0) fail_wav(origin, at, "fmt declares a sample rate of 0");
-      const bool pcm = format == 1 && (bits == 16 || bits == 24);
-      const bool flt = format == 3 && bits == 32;
+      const bool pcm = format == 1 && (bits == 8 || bits == 16 || bits == 24 || bits == 32);
+      const bool flt = format == 3 && (bits == 32 || bits == 64);
       if (!pcm && !flt) {
         fail_wav(origin, at, "unsupported sample format (format " + std::to_string(format) + ", " +
-                                 std::to_string(bits) + " bits); valid: 16/24-bit PCM, 32-bit float");
+                                 std::to_string(bits) + " bits); valid: 8/16/24/32-bit PCM, 32/64-bit float");
       }
       WavLayout w;
       w.rate = rate;
@@ -327,17 +327,36 @@ void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const st
                  double* out) {
   const std::size_t f = w.frame;
   const auto* u = reinterpret_cast<const unsigned char*>(p);
-  if (w.flt) {
+  auto le = [](const unsigned char* b, int n) {  // n little-endian bytes
+    std::uint64_t v = 0;
+    for (int i = n - 1; i >= 0; --i) v = (v << 8) | b[i];
+    return v;
+  };
+  auto not_finite = [&](std::size_t k) {
+    const std::size_t i = i0 + k;
+    fail_wav(origin, w.body + i * w.frame, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
+  };
+  if (w.flt && w.bits == 32) {
     for (std::size_t k = 0; k < frames; ++k, u += f) {
-      const std::uint32_t bits = static_cast<std::uint32_t>(u[0]) | (static_cast<std::uint32_t>(u[1]) << 8) |
-                                 (static_cast<std::uint32_t>(u[2]) << 16) | (static_cast<std::uint32_t>(u[3]) << 24);
+      const auto bits = static_cast<std::uint32_t>(le(u, 4));
       float x;
       std::memcpy(&x, &bits, sizeof x);
-      if (!std::isfinite(x)) {
-        const std::size_t i = i0 + k;
-        fail_wav(origin, w.body + i * w.frame, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
-      }
+      if (!std::isfinite(x)) not_finite(k);
       out[k] = x;
+    }
+  } else if (w.flt) {  // 64-bit float
+    for (std::size_t k = 0; k < frames; ++k, u += f) {
+      const std::uint64_t bits = le(u, 8);
+      double x;
+      std::memcpy(&x, &bits, sizeof x);
+      if (!std::isfinite(x)) not_finite(k);
+      out[k] = x;
+    }
+  } else if (w.bits == 8) {  // unsigned, 128 is zero
+    for (std::size_t k = 0; k < frames; ++k, u += f) out[k] = (static_cast<int>(u[0]) - 128) / 128.0;
+  } else if (w.bits == 32) {
+    for (std::size_t k = 0; k < frames; ++k, u += f) {
+      out[k] = static_cast<std::int32_t>(static_cast<std::uint32_t>(le(u, 4))) / 2147483648.0;
     }
   } else if (w.bits == 16) {
     for (std::size_t k = 0; k < frames; ++k, u += f) {
@@ -425,7 +444,12 @@ std::string capture_wav(const Capture& c, WavFormat fmt, double full_scale) {
   }
   if (c.t0 != 0) throw InputError("capture: a WAV file starts at t = 0; this capture starts at t0 != 0");
   require_in_range("full_scale", full_scale, 1e-12, 1e12);
-  const int bytes = fmt == WavFormat::Pcm16 ? 2 : fmt == WavFormat::Pcm24 ? 3 : 4;
+  const bool flt = fmt == WavFormat::Float32 || fmt == WavFormat::Float64;
+  const int bytes = fmt == WavFormat::Pcm8    ? 1
+                    : fmt == WavFormat::Pcm16 ? 2
+                    : fmt == WavFormat::Pcm24 ? 3
+                    : fmt == WavFormat::Float64 ? 8
+                                                : 4;
   const std::uint32_t data = static_cast<std::uint32_t>(c.samples.size() * static_cast<std::size_t>(bytes));
   std::string out;
   auto put = [&](std::uint64_t v, int n) {
@@ -435,7 +459,7 @@ std::string capture_wav(const Capture& c, WavFormat fmt, double full_scale) {
   put(36 + data, 4);
   out += "WAVEfmt ";
   put(16, 4);
-  put(fmt == WavFormat::Float32 ? 3 : 1, 2);
+  put(flt ? 3 : 1, 2);
   put(1, 2);
   put(static_cast<std::uint32_t>(r), 4);
   put(static_cast<std::uint64_t>(r) * static_cast<std::uint64_t>(bytes), 4);
@@ -449,10 +473,16 @@ std::string capture_wav(const Capture& c, WavFormat fmt, double full_scale) {
       std::uint32_t u;
       std::memcpy(&u, &f, sizeof u);
       put(u, 4);
+    } else if (fmt == WavFormat::Float64) {
+      std::uint64_t u;
+      std::memcpy(&u, &x, sizeof u);
+      put(u, 8);
     } else {
-      const double scale = fmt == WavFormat::Pcm16 ? 32768.0 : 8388608.0;
+      // 2^(bits-1); 8-bit PCM is unsigned, offset by 128
+      const double scale = std::ldexp(1.0, 8 * bytes - 1);
       const double q = std::clamp(std::round(x / full_scale * scale), -scale, scale - 1);
-      put(static_cast<std::uint64_t>(static_cast<std::int64_t>(q)), bytes);
+      const auto v = static_cast<std::int64_t>(q) + (fmt == WavFormat::Pcm8 ? 128 : 0);
+      put(static_cast<std::uint64_t>(v), bytes);
     }
   }
   return out;

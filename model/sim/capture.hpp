@@ -8,8 +8,9 @@
 // within 2 % of a step of the uniform grid from the first to the last time); the sample rate
 // is the number of steps over the time span. t0 is the time of the first row (the scope's
 // pre-trigger makes it negative), t = 0 being the start of transmission of the first burst.
-// WAV: RIFF/WAVE, 16- or 24-bit PCM or 32-bit IEEE float (also as WAVE_FORMAT_EXTENSIBLE),
-// mono or the first channel of several; t0 = 0; PCM values are read as full-scale fractions.
+// WAV: RIFF/WAVE, 8-bit (unsigned), 16-, 24- or 32-bit PCM, or 32- or 64-bit IEEE float (also
+// as WAVE_FORMAT_EXTENSIBLE), mono or the first channel of several; t0 = 0; PCM values are read
+// as full-scale fractions (code / 2^(bits-1), 8-bit as (code - 128) / 128).
 // Every error is an InputError naming the file and line (CSV) or byte offset (WAV).
 //
 // Metadata (what `simulate --write-captures` knows about the stream), all optional:
@@ -56,7 +57,7 @@ Capture read_capture(const std::string& path);
 Capture parse_capture_csv(const std::string& text, const std::string& origin);
 Capture parse_capture_wav(const std::string& bytes, const std::string& origin);
 
-enum class WavFormat { Pcm16, Pcm24, Float32 };
+enum class WavFormat { Pcm8, Pcm16, Pcm24, Pcm32, Float32, Float64 };
 
 // CSV: a Tektronix-like header ("Model,ranging simulate", "Sample Interval,...", "TIME,CH1")
 // then time,volts rows with 9 significant digits. WAV: the sample rate rounded to an integer
