@@ -74,6 +74,31 @@ TEST(Capture, TektronixStyleHeaderAndNegativeStartTime) {
   EXPECT_EQ(c.samples.size(), 5u);
 }
 
+// numpy.savetxt (spaces), SPICE / tab-separated and European (';') exports read as the comma
+// file does; a decimal comma is refused naming its line and cell.
+TEST(Capture, CsvWithSemicolonTabOrSpaceSeparatorsReadsTheSame) {
+  std::string comma = "Time (s),Voltage (V)\n", semi = "time;volts\n", tab = "time\tV(out)\n", space = "# time volts\n";
+  for (int n = 0; n < 50; ++n) {
+    const std::string t = sci(-1e-6 + n * 2e-7), v = sci(0.3 * std::sin(0.7 * n));
+    comma += t + "," + v + "\n";
+    semi += t + ";" + v + "\r\n";
+    tab += t + "\t" + v + "\t" + sci(-1.0) + "\n";
+    space += "  " + t + "   " + v + " \n";
+  }
+  const Capture ref = parse_capture_csv(comma, "c.csv");
+  ASSERT_EQ(ref.samples.size(), 50u);
+  EXPECT_NEAR(ref.sample_rate, 5e6, 1e-3);
+  for (const auto& [text, name] : {std::pair{semi, "s.csv"}, std::pair{tab, "t.csv"}, std::pair{space, "w.csv"}}) {
+    const Capture c = parse_capture_csv(text, name);
+    EXPECT_EQ(c.samples, ref.samples) << name;
+    EXPECT_EQ(c.sample_rate, ref.sample_rate) << name;
+    EXPECT_EQ(c.t0, ref.t0) << name;
+  }
+  EXPECT_NE(error_of_csv("time;volts\n0;0,5\n").find("cap.csv:2: voltage column: '0,5' is not a number"),
+            std::string::npos)
+      << error_of_csv("time;volts\n0;0,5\n");
+}
+
 TEST(Capture, BadCsvNamesFileAndLine) {
   const std::string head = "TIME,CH1\n0,0\n2e-7,0.1\n";
   auto has = [](const std::string& text, const std::string& what) {

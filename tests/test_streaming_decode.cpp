@@ -5,6 +5,8 @@
 // CaptureSource refuses what read_capture refuses, with the same message.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <unistd.h>
 
 #include <filesystem>
@@ -149,6 +151,12 @@ TEST(StreamingDecode, Pcm16WavAndCsvEqualWholeFile) {
   Capture c = capture();
   c.t0 = -2e-5;  // a scope's pre-trigger
   check_file(write("train.csv", capture_csv(c)), "float");
+  // the same rows separated by ';' and by tabs (the stream reads the value as the scan splits)
+  for (const char sep : {';', '\t'}) {
+    std::string text = capture_csv(c);
+    std::replace(text.begin(), text.end(), ',', sep);
+    check_file(write(sep == ';' ? "train_semi.csv" : "train_tab.csv", text), "float");
+  }
 }
 
 TEST(StreamingDecode, SamplesAndMetadataAsReadCapture) {

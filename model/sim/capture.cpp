@@ -18,6 +18,25 @@
 #include "model/sim/capture_stream.hpp"
 
 namespace ranging {
+
+char csv_separator(const std::string& line) {
+  if (line.find(';') != std::string::npos) return ';';
+  if (line.find(',') != std::string::npos) return ',';
+  return '\0';
+}
+
+double csv_row_value(const std::string& line) {
+  const char sep = csv_separator(line);
+  const char* p = line.c_str();
+  if (sep != '\0') {
+    p += line.find(sep) + 1;
+  } else {  // whitespace-separated: past the first token
+    while (*p == ' ' || *p == '\t') ++p;
+    while (*p != '\0' && *p != ' ' && *p != '\t') ++p;
+  }
+  while (*p == ' ' || *p == '\t' || *p == '"') ++p;
+  return std::strtod(p, nullptr);
+}
 namespace {
 
 [[noreturn]] void fail_at(const std::string& origin, std::size_t line, const std::string& what) {
@@ -41,12 +60,20 @@ bool parse_number(const std::string& cell, double& out) {
   return end == b + cell.size() && errno != ERANGE;
 }
 
+// The cells of one line. Separator (csv_separator): ';' if the line has one (a European export;
+// decimal commas are not read: such a cell is refused as not a number), else ',' if it has one,
+// else runs of tabs and spaces (numpy.savetxt's default, SPICE and tab-separated exports).
 std::vector<std::string> split_cells(const std::string& line) {
   std::vector<std::string> cells;
   std::string cell;
+  const char sep = csv_separator(line);
   std::stringstream ss(line);
-  while (std::getline(ss, cell, ',')) cells.push_back(trim(cell));
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  if (sep == '\0') {
+    while (ss >> cell) cells.push_back(cell);
+    return cells;
+  }
+  while (std::getline(ss, cell, sep)) cells.push_back(trim(cell));
+  if (!line.empty() && line.back() == sep) cells.emplace_back();
   return cells;
 }
 

@@ -4,8 +4,10 @@
 //
 // CSV: optional header lines (anything before the first row whose first cell is a number,
 // e.g. a Tektronix export's "Record Length,..." lines and its "TIME,CH1" line), then rows
-// "time_s,volts[,more columns ignored]". Time must increase with an even step (every sample
-// within 2 % of a step of the uniform grid from the first to the last time); the sample rate
+// "time_s,volts[,more columns ignored]", or separated by ';', tabs or spaces (a line with a ';' is
+// split on ';', else one with a ',' on ',', else on runs of whitespace: numpy.savetxt, SPICE and
+// European exports; decimal commas are refused). Time must increase with an even step (every
+// sample within 2 % of a step of the uniform grid from the first to the last time); the sample rate
 // is the number of steps over the time span. t0 is the time of the first row (the scope's
 // pre-trigger makes it negative), t = 0 being the start of transmission of the first burst.
 // WAV: RIFF/WAVE, 8-bit (unsigned), 16-, 24- or 32-bit PCM, or 32- or 64-bit IEEE float (also

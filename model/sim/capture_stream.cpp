@@ -98,10 +98,7 @@ std::size_t CaptureSource::read(std::span<double> out) {
       ++lineno_;
       if (lineno_ < first_data_line_) continue;
       // The rows were validated at open: the second cell is a finite number.
-      const auto c1 = line.find(',');
-      const char* p = line.c_str() + c1 + 1;
-      while (*p == ' ' || *p == '\t' || *p == '"') ++p;
-      out[k++] = std::strtod(p, nullptr);
+      out[k++] = csv_row_value(line);
       ++pos_;
     }
     if (k < out.size() && pos_ < n_) throw InputError(path_ + ": changed while it was read (fewer rows than at open)");

@@ -25,6 +25,11 @@
 
 namespace ranging {
 
+// A CSV line's separator: ';' if it has one, else ',' if it has one, else '\0' (runs of tabs
+// and spaces). csv_row_value: the second cell of a data row that CsvCaptureScan validated.
+char csv_separator(const std::string& line);
+double csv_row_value(const std::string& line);
+
 class CsvCaptureScan {
  public:
   explicit CsvCaptureScan(std::string origin);
