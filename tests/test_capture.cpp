@@ -224,6 +224,28 @@ TEST(DecodeCli, DecodesSimulatedCapturesBackToTheSimulatedResults) {
   EXPECT_EQ(nlohmann::json::parse(p16.out)["detections"][0]["code"], 6);
 }
 
+// A capture at 4 MS/s (a common scope rate that does not divide the 30 MHz receiver clock) is
+// decoded: the receiver's clock moves to 32 MHz with a warning on stderr, the code and distance
+// are the simulated ones.
+TEST(DecodeCli, ACaptureWhoseRateDoesNotDivideTheClockDecodes) {
+  const std::string dir = ::testing::TempDir() + "/capture_4ms_" + std::to_string(::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write(dir + "/s.yaml", "name: r4\nsample_rate: 4000000\ntransducers: {}\ngeometry:\n  distances_m: [0.6]\n"
+                         "excitation:\n  family: Gold4\n  codes: [5]\nnoise:\n  noise_v: 0.002\n");
+  const ToolRun sim = run_tool("simulate " + dir + "/s.yaml --out " + dir + "/out --write-captures --quiet --json");
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  EXPECT_NE(sim.err.find("the receiver's clock is 32 MHz (8 clocks per sample)"), std::string::npos) << sim.err;
+  const ToolRun dec = run_tool("decode " + dir + "/out/captures/Gold4_600mm_r1_j5.wav --family Gold4 --json");
+  ASSERT_EQ(dec.status, 0) << dec.err;
+  EXPECT_NE(dec.err.find("the receiver's clock is 32 MHz"), std::string::npos) << dec.err;
+  const auto j = nlohmann::json::parse(dec.out);
+  EXPECT_EQ(j["sample_rate"], 4e6);
+  ASSERT_GE(j["detections"].size(), 1u) << dec.out;
+  EXPECT_EQ(j["detections"][0]["code"], 5);
+  EXPECT_NEAR(j["detections"][0]["distance_m"].get<double>(), 0.6, 1e-3);
+}
+
 TEST(DecodeCli, BadCapturesExitTwoWithAClearMessageAndNoOutput) {
   const std::string dir = ::testing::TempDir() + "/capture_bad_" + std::to_string(::getpid());
   fs::remove_all(dir);

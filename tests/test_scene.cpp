@@ -1,6 +1,8 @@
 // Scenes: strict loading, "model only what a scene requires" (stage selection), determinism,
 // the medium (speed of sound, ISO 9613-1 absorption) and `ranging simulate`.
 #include <gtest/gtest.h>
+
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -138,6 +140,34 @@ TEST(SceneSimulator, DeterministicForASeedAndTheSeedMatters) {
   std::string other = yaml;
   other.replace(other.find("seed: 7"), 7, "seed: 8");
   EXPECT_NE(run(other)[0].det.energy, a[0].det.energy);
+}
+
+// A sample rate that does not divide the configuration's 30 MHz clock (a 4 MS/s or 20 MS/s
+// scope) gets the next multiple as the receiver's clock, with a warning, and decodes; a rate that
+// divides it keeps the clock and says nothing.
+TEST(SceneSimulator, ASampleRateThatDoesNotDivideTheClockMovesTheClockAndDecodes) {
+  for (const auto& [rate, clock] : {std::pair{4e6, 32e6}, std::pair{20e6, 40e6}, std::pair{5e6, 30e6}}) {
+    std::ostringstream y;
+    y << "sample_rate: " << rate << "\ntransducers: {}\ngeometry:\n  distances_m: [0.3, 0.8]\n"
+      << "excitation:\n  family: Gold4\n  codes: [2, 7]\nnoise:\n  noise_v: 0.002\n";
+    const Scene scene = parse_scene(y.str(), "s.yaml");
+    SCOPED_TRACE(rate);
+    EXPECT_EQ(scene.receiver.config.clock_hz, clock);
+    const bool moved = clock != 30e6;
+    ASSERT_EQ(scene.warnings.size(), moved ? 1u : 0u);
+    if (moved) {
+      EXPECT_NE(scene.warnings[0].find("does not divide the receiver's hardware.clock_hz (30 MHz)"), std::string::npos)
+          << scene.warnings[0];
+    }
+    SceneSimulator sim(scene);
+    const auto rows = sim.run("Gold4");
+    ASSERT_EQ(rows.size(), 4u);
+    for (const auto& r : rows) {
+      EXPECT_TRUE(r.detected);
+      EXPECT_EQ(r.det.code, r.code_sent);
+      EXPECT_LT(std::abs(r.error_m), 1e-3);
+    }
+  }
 }
 
 TEST(SceneSimulator, StagesChangeTheSignalAsTheyShould) {

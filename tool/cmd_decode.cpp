@@ -183,6 +183,7 @@ int cmd_decode(const Args& args) {
        << "\ntransducers: {}\ngeometry:\n  distances_m: [1.0]\nexcitation:\n  family: " << family << "\n";
   if (p.has("--references")) yaml << "receiver:\n  reference: files\n  references_dir: \"" << *p.get("--references") << "\"\n";
   Scene scene = parse_scene(yaml.str(), path, ".", parse_overrides(p.values("--set")), p.has("--allow-out-of-spec"));
+  for (const auto& w : scene.warnings) std::fprintf(stderr, "ranging decode: warning: %s\n", w.c_str());
   if (!scene.receiver.metrics.pearson) {  // --min-rho selects the bursts by the Pearson rho
     throw InputError("option --set: receiver.metrics: decode reports bursts by their Pearson rho (--min-rho); "
                      "the metrics must include pearson");

@@ -255,6 +255,20 @@ void derive_receiver_config(Scene& s, const YAML::Node& root, const std::string&
   rc.cycles_per_chip = s.excitation.cycles_per_chip;
   rc.fs = s.fs;
   rc.filter.fs = s.fs;
+  // The hardware clock (the RTL's: clock_hz / fs clocks per sample, an integer) follows the
+  // sample rate too: a scene rate that does not divide the configuration's clock (4, 4.8 or 20
+  // MS/s into 30 MHz) gets the next multiple of it, said in a warning. The model's results
+  // do not depend on the clock.
+  if (const double per = rc.clock_hz / rc.fs;
+      per > 0 && std::abs(per - std::round(per)) > 1e-9 * per && std::ceil(per) * rc.fs <= 500e6) {
+    std::ostringstream os;
+    os.precision(9);
+    os << s.origin << ": sample_rate: " << s.fs / 1e6 << " MS/s does not divide the receiver's hardware.clock_hz ("
+       << rc.clock_hz / 1e6 << " MHz); the receiver's clock is " << std::ceil(per) * rc.fs / 1e6 << " MHz ("
+       << std::ceil(per) << " clocks per sample)";
+    s.warnings.push_back(os.str());
+    rc.clock_hz = std::ceil(per) * rc.fs;
+  }
   rc.family = s.excitation.families.front();
   if (s.receiver.reference != "files") rc.reference = s.receiver.reference;
   rc.reference_transducer.centre_hz = s.transducers.centre_hz;
