@@ -224,6 +224,56 @@ TEST(PearsonOverLags, FftBankEqualsTheDirectDefinition) {
   EXPECT_EQ(bank.search(flat, 0, 600)[0].rho, 0.0);
 }
 
+// The bank screens the lags by out/den before it divides (metrics.cpp): its result must be the
+// plain loop's (every lag's rho, the first of the largest) bit for bit, also where that rule is
+// delicate: the template repeated (rho about 1 at several lags, some clamped at 1), flat windows
+// (rho 0 everywhere: the first lag), a signal that only anticorrelates, tiny and huge amplitudes,
+// and noise.
+TEST(PearsonOverLags, ScreeningTheLagsGivesThePlainLoopsResultBitForBit) {
+  std::vector<std::vector<double>> ts;
+  for (std::uint64_t j = 0; j < 3; ++j) ts.push_back(random_signal(64, 3 + j));
+  PearsonBank screened(ts), plain(ts);
+  plain.set_screening(false);
+  std::vector<std::vector<double>> xs;
+  std::vector<double> rep;
+  for (int r = 0; r < 6; ++r) {  // template 0 every 80 samples, 16 zeros between
+    rep.insert(rep.end(), ts[0].begin(), ts[0].end());
+    rep.insert(rep.end(), 16, 0.0);
+  }
+  xs.push_back(rep);
+  xs.push_back(std::vector<double>(500, -2.5));  // flat
+  std::vector<double> neg(500, 0.0);
+  for (std::size_t i = 0; i < 64; ++i) neg[100 + i] = -ts[1][i];
+  xs.push_back(neg);
+  for (double scale : {1e-150, 1e-300, 1e150}) {
+    std::vector<double> y = rep;
+    for (double& v : y) v *= scale;
+    xs.push_back(y);
+  }
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    auto x = random_signal(600, 100 + seed);
+    for (std::size_t i = 0; i < 64; ++i) x[200 + seed * 7 + i] += (seed % 5) * ts[seed % 3][i];
+    xs.push_back(x);
+  }
+  std::size_t cases = 0;
+  for (const auto& x : xs) {
+    for (auto [lo, hi] : {std::pair<long, long>{-5, 600}, {3, 400}, {81, 200}, {90, 110}, {150, 151}}) {
+      const auto a = screened.search(x, lo, hi), b = plain.search(x, lo, hi);
+      ASSERT_EQ(a.size(), b.size());
+      for (std::size_t j = 0; j < a.size(); ++j) {
+        EXPECT_EQ(a[j].lag, b[j].lag) << cases << " " << j;
+        EXPECT_EQ(a[j].rho, b[j].rho) << cases << " " << j;
+      }
+      ++cases;
+    }
+  }
+  EXPECT_EQ(cases, xs.size() * 5);
+  // and the cases are what they claim: rho 1 on the repeats, 0 when flat (at the first lag)
+  EXPECT_NEAR(screened.search(rep, 3, 400)[0].rho, 1.0, 1e-12);
+  EXPECT_EQ(screened.search(xs[1], 7, 300)[0].rho, 0.0);
+  EXPECT_EQ(screened.search(xs[1], 7, 300)[0].lag, 7);
+}
+
 TEST(PearsonOverLags, AgreesWithNumpyOracle) {
   std::vector<std::vector<double>> ts;
   for (std::uint64_t j = 0; j < 3; ++j) ts.push_back(random_signal(120, 20 + j));

@@ -142,8 +142,14 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     den[k] = var;
     den_max = std::max(den_max, var);
   }
-  // Per lag, once for every template: den becomes sqrt(var) (0 where the window is flat: rho = 0 there).
-  for (double& d : den) d = d > 1e-24 * den_max && d > 0 ? std::sqrt(d) : 0.0;
+  // Per lag, once for every template: den becomes sqrt(var) (0 where the window is flat: rho = 0
+  // there), inv_den its reciprocal (0 there) for the screening below.
+  std::vector<double> inv_den(lags);
+  for (std::size_t k = 0; k < lags; ++k) {
+    double& d = den[k];
+    d = d > 1e-24 * den_max && d > 0 ? std::sqrt(d) : 0.0;
+    inv_den[k] = d > 0 ? 1.0 / d : 0.0;
+  }
   std::fill(p.in, p.in + nfft, 0.0);
   for (std::size_t i = 0; i < w; ++i) p.in[i] = xw[i] - mean;
   fftw_execute(p.fwd);
@@ -164,9 +170,29 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     fftw_execute(p.inv);  // unnormalized: out = nfft * correlation
     LagRho best{-2.0, a};
     const double tn = tnorm_[j];
-    for (std::size_t k = 0; k < lags; ++k) {
+    // rho_k = clamp(out_k / nfft / (den_k tn), -1, 1) (0 where den_k = 0), the first lag of the
+    // largest wins. A division per lag is most of the search's time, so the lags are screened
+    // first by g_k = out_k / den_k (a multiply: inv_den), which orders them as rho_k does to a
+    // few ulps (rho_k = g_k / (nfft tn) up to rounding), and rho_k is computed exactly as above
+    // only for the lags that can be the first maximum: g_k within 1e-12 (relative) of the
+    // largest g, or (when rho reaches the clamp at 1) of g at rho = 1. So the result is the one
+    // of the plain loop, bit for bit. If the largest rho is itself clamped at -1, every lag is.
+    const double* o = p.out;
+    const double g1 = tn / inv_nfft;  // g at rho = 1
+    double m4[4] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // four chains: no serial max
+    std::size_t k = 0;
+    for (; k + 4 <= lags; k += 4) {
+      for (std::size_t u = 0; u < 4; ++u) m4[u] = std::max(m4[u], o[k + u] * inv_den[k + u]);
+    }
+    for (; k < lags; ++k) m4[0] = std::max(m4[0], o[k] * inv_den[k]);
+    const double gmax = std::max(std::max(m4[0], m4[1]), std::max(m4[2], m4[3]));
+    const double lo = (screen_ && tn > 0 && gmax >= -g1 * (1 - 1e-9))
+                          ? std::min(gmax, g1 * (1 - 1e-9)) - (std::abs(gmax) + g1) * 1e-12 - 1e-290
+                          : -HUGE_VAL;
+    for (k = 0; k < lags; ++k) {
+      if (!(o[k] * inv_den[k] >= lo)) continue;
       double r = 0;
-      if (den[k] > 0 && tn > 0) r = std::clamp(p.out[k] * inv_nfft / (den[k] * tn), -1.0, 1.0);
+      if (den[k] > 0 && tn > 0) r = std::clamp(o[k] * inv_nfft / (den[k] * tn), -1.0, 1.0);
       if (r > best.rho) best = {r, a + static_cast<long>(k)};
     }
     out.push_back(best);

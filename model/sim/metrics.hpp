@@ -48,11 +48,15 @@ class PearsonBank {
   std::size_t size() const { return t_.size(); }
   // One LagRho per template. InputError as pearson_over_lags.
   std::vector<LagRho> search(std::span<const double> x, long lo, long hi);
+  // The lags are screened by a multiply before rho is divided out (the same result bit for bit);
+  // off: every lag's rho is computed (the reference the tests compare the screening with).
+  void set_screening(bool on) { screen_ = on; }
 
  private:
   struct Plan;
   Plan& plan(std::size_t nfft);
   std::size_t n_ = 0;
+  bool screen_ = true;
   std::vector<std::vector<double>> t_;  // centred templates
   std::vector<double> tnorm_;           // sqrt(sum tc^2)
   std::map<std::size_t, std::unique_ptr<Plan>> plans_;
