@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "model/base/error.hpp"
 #include "model/sim/fft.hpp"
 
 using namespace ranging;
@@ -68,4 +69,26 @@ TEST(Convolve, ThreadsMayConvolveAtOnce) {
   }
   for (auto& th : t) th.join();
   for (const auto& g : got) EXPECT_EQ(g, want);
+}
+
+// fft_size: the smallest 2^a 3^b 5^c 7^d >= n, checked against a brute-force scan.
+TEST(FftSize, IsTheSmallestSevenSmoothNumberAtLeastN) {
+  auto smooth = [](std::size_t v) {
+    for (std::size_t p : {2u, 3u, 5u, 7u}) {
+      while (v % p == 0) v /= p;
+    }
+    return v == 1;
+  };
+  std::size_t expect = 1;
+  for (std::size_t n = 1; n <= 5000; ++n) {
+    if (expect < n) {
+      expect = n;
+      while (!smooth(expect)) ++expect;
+    }
+    ASSERT_EQ(fft_size(n), expect) << n;
+  }
+  EXPECT_EQ(fft_size(0), 1u);
+  EXPECT_EQ(fft_size(1043), 1050u);  // 2 3 5^2 7: the decode's Pearson window of 1043 samples
+  EXPECT_EQ(fft_size(std::size_t{1} << 40), std::size_t{1} << 40);
+  EXPECT_THROW(fft_size((std::size_t{1} << 40) + 1), InputError);
 }

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <new>
+#include <string>
 
 #include <fftw3.h>
+
+#include "model/base/error.hpp"
 
 namespace ranging {
 
@@ -91,6 +94,24 @@ std::vector<double> convolve(std::span<const double> a, std::span<const double> 
   const double scale = 1.0 / static_cast<double>(n);  // exact: n is a power of two
   for (double& v : c) v *= scale;
   return c;
+}
+
+std::size_t fft_size(std::size_t n) {
+  if (n > (std::size_t{1} << 40)) throw InputError("fft_size: " + std::to_string(n) + " points; valid up to 2^40");
+  if (n <= 1) return 1;
+  std::size_t best = 1;
+  while (best < n) best *= 2;  // the next power of two: < 2n
+  // every 2^a 3^b 5^c 7^d >= n below best: the products of 3, 5, 7 powers, then doubled up to n
+  for (std::size_t p7 = 1; p7 < best; p7 *= 7) {
+    for (std::size_t p5 = p7; p5 < best; p5 *= 5) {
+      for (std::size_t p3 = p5; p3 < best; p3 *= 3) {
+        std::size_t v = p3;
+        while (v < n) v *= 2;
+        best = std::min(best, v);
+      }
+    }
+  }
+  return best;
 }
 
 }  // namespace ranging

@@ -25,4 +25,9 @@ inline constexpr std::size_t kDirectTaps = 64;
 
 std::vector<double> convolve(std::span<const double> a, std::span<const double> b);
 
+// The smallest n' >= n whose only prime factors are 2, 3, 5 and 7 (FFTW's fast sizes): a
+// transform of n' points costs about what one of n does, where the next power of two may
+// cost up to twice as much. n <= 2^40 (InputError beyond).
+std::size_t fft_size(std::size_t n);
+
 }  // namespace ranging

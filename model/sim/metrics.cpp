@@ -119,8 +119,8 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   const auto [a, b] = valid_lags(x.size(), n_, lo, hi);
   const std::size_t lags = static_cast<std::size_t>(b - a) + 1;
   const std::size_t w = lags + n_ - 1;  // window x[a, b + N)
-  std::size_t nfft = 64;
-  while (nfft < w) nfft *= 2;
+  // any size >= w holds the lags' circular correlation without wrap: the next fast size
+  const std::size_t nfft = std::max<std::size_t>(64, fft_size(w));
   Plan& p = plan(nfft);
   const double* xw = x.data() + a;
   double mean = 0;
@@ -154,7 +154,7 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   for (std::size_t i = 0; i < w; ++i) p.in[i] = xw[i] - mean;
   fftw_execute(p.fwd);
   const std::size_t nc = nfft / 2 + 1;
-  // 1/nfft is a power of two: x * inv_nfft is x / nfft exactly.
+  // 1/nfft (rounded unless nfft is a power of two: rho's rounding stays a few ulps)
   const double inv_nfft = 1.0 / static_cast<double>(nfft);
   std::vector<LagRho> out;
   for (std::size_t j = 0; j < t_.size(); ++j) {
