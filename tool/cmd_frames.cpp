@@ -21,6 +21,7 @@
 #include <iterator>
 
 #include "model/base/error.hpp"
+#include "model/base/input_file.hpp"
 #include "model/hw/frames.hpp"
 #include "tool/cli.hpp"
 #include "tool/commands.hpp"
@@ -184,9 +185,9 @@ int cmd_frames(const Args& args) {
     std::cin >> std::noskipws;
     bytes.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
   } else {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) throw InputError(path + ": cannot read");
-    bytes.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    // a missing file, a folder, an unreadable or a > 1 GiB file: exit 2 with what it is
+    const std::string text = read_input_file(path, "byte capture", std::size_t{1} << 30);
+    bytes.assign(text.begin(), text.end());
   }
   if (!decoded) frames = decode_uart_frames(bytes, st);
   if (p.has("--json")) {
