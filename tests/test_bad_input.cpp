@@ -221,11 +221,13 @@ std::vector<Case> catalogue() {
       {"wav: fmt chunk past the end", {{"x.wav", wav_fmt_long}}, dec + "{d}/x.wav", {"x.wav: byte 12", "fmt chunk"}},
       {"wav: zero-length file", {{"x.wav", ""}}, dec + "{d}/x.wav", {"x.wav: byte 0: empty file"}},
       {"capture: unknown type", {{"x.txt", "0,0\n"}}, dec + "{d}/x.txt", {"x.txt", "valid: .csv"}},
+      {"decode --references a file", {{"x.csv", csv_capture(3000)}}, dec + "{d}/x.csv --references {d}/x.csv",
+       {"x.csv: not a folder; expected the references folder"}},
       // --- UART byte captures (frames) ---
       {"frames: a folder", {{"u.bin", kDir}}, "frames {d}/u.bin", {"u.bin: is a folder; expected a byte capture"}},
       {"frames: missing file", {}, "frames {d}/u.bin", {"u.bin: cannot open the byte capture"}},
       {"decode: missing references folder", {{"x.csv", csv_capture(3000)}}, dec + "{d}/x.csv --references {d}/nope",
-       {"nope"}},
+       {"nope: no such folder; expected the references folder"}},
   };
 }
 

@@ -403,6 +403,13 @@ struct SceneSimulator::Link {
     const Scene& s = *scene;
     namespace fs = std::filesystem;
     const std::string stem = s.receiver.references_dir + "/" + family_name + "-" + std::to_string(j);
+    std::error_code ec;
+    if (!fs::is_directory(s.receiver.references_dir, ec)) {
+      throw InputError(s.receiver.references_dir + (fs::exists(s.receiver.references_dir, ec)
+                                                         ? ": not a folder; expected the references folder"
+                                                         : ": no such folder; expected the references folder") +
+                       " (" + family_name + "-<j>.csv or .wav inside)");
+    }
     std::string path;
     for (const char* ext : {".csv", ".wav"}) {
       if (fs::exists(stem + ext)) path = stem + ext;
