@@ -117,6 +117,33 @@ TEST_F(Sweep, ShardsMergedAndParallelJobsEqualTheSerialRun) {
   EXPECT_FALSE(fs::exists(dir_ / "bad"));
 }
 
+// A scene whose sample rate does not divide a point's clock: the scene alone would move the
+// receiver's clock (a warning), but a sweep point keeps the clock it asks for, so that point is
+// a recorded refusal naming the clock; a clock that is a multiple is evaluated at that clock.
+TEST_F(Sweep, APointWhoseClockIsNotAMultipleOfTheSampleRateIsRefused) {
+  std::ofstream(dir_ / "scene.yaml") << "name: tiny4\nsample_rate: 4000000\ntransducers: {}\n"
+                                        "geometry:\n  distances_m: [0.3]\nexcitation:\n  family: Gold4\n  codes: [1, 5]\n";
+  const fs::path s = spec("clk", "  - key: hardware.clock_hz\n    values: [30000000, 40000000]\n");
+  const json j = result(run(s, "out"));
+  std::size_t refused = 0, evaluated = 0;
+  for (const auto& p : j["points"]) {
+    const bool asks_30 = !p["params"].contains("hardware.clock_hz") || p["params"]["hardware.clock_hz"] == "30000000";
+    if (asks_30) {
+      ++refused;
+      EXPECT_EQ(p["status"], "refused") << p.dump();
+      EXPECT_NE(p.value("error", "").find("hardware.clock_hz: 30000000 is not a multiple of the scene's sample_rate"),
+                std::string::npos)
+          << p.dump();
+    } else {
+      ++evaluated;
+      EXPECT_EQ(p["status"], "ok") << p.dump();
+      EXPECT_EQ(p["cost"]["clocks_per_sample_available"], 10) << p.dump();
+    }
+  }
+  EXPECT_EQ(refused, 2u);  // the base and the 30 MHz point
+  EXPECT_EQ(evaluated, 1u);
+}
+
 TEST_F(Sweep, AReRunKeepsThePointsDoneAndRunsTheRest) {
   const fs::path s = spec("grid", grid_axes());
   const fs::path d = run(s, "out");

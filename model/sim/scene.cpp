@@ -267,6 +267,7 @@ void derive_receiver_config(Scene& s, const YAML::Node& root, const std::string&
        << rc.clock_hz / 1e6 << " MHz); the receiver's clock is " << std::ceil(per) * rc.fs / 1e6 << " MHz ("
        << std::ceil(per) << " clocks per sample)";
     s.warnings.push_back(os.str());
+    s.moved_clock_from_hz = rc.clock_hz;
     rc.clock_hz = std::ceil(per) * rc.fs;
   }
   rc.family = s.excitation.families.front();

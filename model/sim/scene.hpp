@@ -145,8 +145,13 @@ struct Scene {
   // single mode (every burst alone in its stream: no ambiguity).
   double unambiguous_range_m(int eta) const;
   // Warnings found at load (the tools print them on stderr): a periodic scene whose largest
-  // distance reaches the unambiguous range eta * c * T of a family.
+  // distance reaches the unambiguous range eta * c * T of a family; a receiver clock moved to a
+  // multiple of sample_rate.
   std::vector<std::string> warnings;
+  // The configuration's hardware.clock_hz when it did not divide by sample_rate and the
+  // receiver's clock was moved to the next multiple (receiver.config.clock_hz); a sweep refuses
+  // such a point, whose requested clock would not be the one evaluated.
+  std::optional<double> moved_clock_from_hz;
 };
 
 // overrides (--set KEY=VALUE, model/config/overrides.hpp) apply to the scene document before it

@@ -385,6 +385,14 @@ json evaluate_point(const SweepSpec& spec, const PointDef& point, const PointOpt
   json out{{"id", point.id}, {"params", params}, {"default", point.params.empty()}};
   try {
     Scene scene = load_scene(spec.scene_path, point_overrides(spec, point.params));
+    if (scene.moved_clock_from_hz) {  // the point's clock would not be the one evaluated
+      std::ostringstream os;
+      os.precision(9);
+      os << "hardware.clock_hz: " << *scene.moved_clock_from_hz << " is not a multiple of the scene's sample_rate "
+         << scene.fs << " (a scene would move the receiver's clock to " << scene.receiver.config.clock_hz
+         << "; a sweep point keeps the clock it asks for)";
+      throw InputError(os.str());
+    }
     const ReceiverDesign design = design_receiver(scene.receiver.config);
     check_generatable(design);
     // Fixed model, timed.
