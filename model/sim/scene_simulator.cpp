@@ -394,15 +394,16 @@ struct SceneSimulator::Link {
     }
     // Recorded references are aligned by the receiver's calibrated arrival, so every offset first.
     if (s.receiver.reference == "files") {
+      check_references_dir();
       for (std::size_t j = 0; j < eta; ++j) templates[j] = load_reference(static_cast<int>(j) + 1);
     }
     bank = std::make_unique<PearsonBank>(templates);
   }
 
-  std::vector<double> load_reference(int j) {
+  // The references folder itself, once: a file or a missing path is named as such.
+  void check_references_dir() const {
     const Scene& s = *scene;
     namespace fs = std::filesystem;
-    const std::string stem = s.receiver.references_dir + "/" + family_name + "-" + std::to_string(j);
     std::error_code ec;
     if (!fs::is_directory(s.receiver.references_dir, ec)) {
       throw InputError(s.receiver.references_dir + (fs::exists(s.receiver.references_dir, ec)
@@ -410,6 +411,12 @@ struct SceneSimulator::Link {
                                                          : ": no such folder; expected the references folder") +
                        " (" + family_name + "-<j>.csv or .wav inside)");
     }
+  }
+
+  std::vector<double> load_reference(int j) {
+    const Scene& s = *scene;
+    namespace fs = std::filesystem;
+    const std::string stem = s.receiver.references_dir + "/" + family_name + "-" + std::to_string(j);
     std::string path;
     for (const char* ext : {".csv", ".wav"}) {
       if (fs::exists(stem + ext)) path = stem + ext;
