@@ -5,7 +5,9 @@
 #include "tests/process.hpp"
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -348,4 +350,159 @@ TEST(DecodeCli, SimulatedCaptureMetadataGivesTheRightDistanceWithDefaultOptions)
   EXPECT_EQ(bad.status, 2);
   EXPECT_TRUE(bad.out.empty());
   EXPECT_NE(bad.err.find("Gold4_1000mm_r1_j5.json: key speed_of_sound"), std::string::npos) << bad.err;
+}
+
+// Several channels (an oscilloscope's CH1..CHn columns, a multi-channel WAV): --channel N
+// reads one; the file's count is reported; a channel the file lacks is refused.
+namespace {
+
+// A 16-bit PCM WAV of interleaved channels (frame i: ch[0][i], ch[1][i], ...).
+std::string wav16(const std::vector<std::vector<double>>& ch, std::uint32_t rate) {
+  const std::size_t n = ch[0].size(), c = ch.size();
+  std::string out;
+  auto put = [&](std::uint64_t v, int b) {
+    for (int i = 0; i < b; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  };
+  const auto data = static_cast<std::uint32_t>(n * c * 2);
+  out += "RIFF";
+  put(36 + data, 4);
+  out += "WAVEfmt ";
+  put(16, 4);
+  put(1, 2);
+  put(c, 2);
+  put(rate, 4);
+  put(rate * c * 2, 4);
+  put(c * 2, 2);
+  put(16, 2);
+  out += "data";
+  put(data, 4);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < c; ++k) {
+      put(static_cast<std::uint64_t>(static_cast<std::int64_t>(std::lround(ch[k][i] * 32768.0))), 2);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(Capture, ChannelsOfAMultiColumnCsvAndAMultiChannelWav) {
+  // CSV: time, three channels, each separator style; column N + 1 is channel N.
+  for (const char* sep : {",", ";", "\t", "  "}) {
+    SCOPED_TRACE(std::string("separator '") + sep + "'");
+    std::string text = "TIME" + std::string(sep) + "CH1" + sep + "CH2" + sep + "CH3\n";
+    for (int n = 0; n < 6; ++n) {
+      text += sci(n * 2e-7) + sep + sci(0.001 * n) + sep + sci(-0.25 * n) + sep + sci(7.0 + n) + "\n";
+    }
+    for (int ch = 1; ch <= 3; ++ch) {
+      const Capture c = parse_capture_csv(text, "scope.csv", ch);
+      EXPECT_EQ(c.channel, ch);
+      EXPECT_EQ(c.channels, 3);
+      ASSERT_EQ(c.samples.size(), 6u);
+      for (int n = 0; n < 6; ++n) {
+        const double want = ch == 1 ? 0.001 * n : ch == 2 ? -0.25 * n : 7.0 + n;
+        EXPECT_DOUBLE_EQ(c.samples[static_cast<std::size_t>(n)], want) << "channel " << ch << " row " << n;
+      }
+    }
+    try {
+      (void)parse_capture_csv(text, "scope.csv", 4);
+      ADD_FAILURE() << "channel 4 of a 3-channel CSV was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("scope.csv:2: channel 4"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("valid 1..3"), std::string::npos) << e.what();
+    }
+  }
+  // A row shorter than the channel read is refused at its line; one channel 1 does not need is fine.
+  const std::string ragged = "0,1,2\n2e-7,3\n4e-7,5,6\n";
+  EXPECT_EQ(parse_capture_csv(ragged, "r.csv", 1).samples.size(), 3u);
+  try {
+    (void)parse_capture_csv(ragged, "r.csv", 2);
+    ADD_FAILURE() << "a row without channel 2 was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("r.csv:2: channel 2"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(parse_capture_csv("0,1,nan\n2e-7,3,4\n", "n.csv", 1).samples.size(), 2u);  // channel 1 ignores column 3
+  try {
+    (void)parse_capture_csv("0,1,nan\n2e-7,3,4\n", "n.csv", 2);
+    ADD_FAILURE() << "NaN in channel 2 was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("n.csv:1: channel 2 column: 'nan' is not finite"), std::string::npos)
+        << e.what();
+  }
+
+  // WAV: three interleaved 16-bit channels.
+  std::vector<std::vector<double>> ch(3);
+  for (int n = 0; n < 50; ++n) {
+    ch[0].push_back(0.5 * std::sin(0.3 * n));
+    ch[1].push_back(-0.25);
+    ch[2].push_back(n / 64.0);
+  }
+  const std::string bytes = wav16(ch, 5000000);
+  for (int k = 1; k <= 3; ++k) {
+    const Capture c = parse_capture_wav(bytes, "daq.wav", k);
+    EXPECT_EQ(c.channels, 3);
+    EXPECT_EQ(c.channel, k);
+    ASSERT_EQ(c.samples.size(), 50u);
+    for (std::size_t n = 0; n < 50; ++n) {
+      EXPECT_NEAR(c.samples[n], ch[static_cast<std::size_t>(k - 1)][n], 1.0 / 32768) << "channel " << k;
+    }
+  }
+  try {
+    (void)parse_capture_wav(bytes, "daq.wav", 4);
+    ADD_FAILURE() << "channel 4 of a 3-channel WAV was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("daq.wav: byte 36: channel 4 is out of range"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("valid 1..3"), std::string::npos) << e.what();
+  }
+}
+
+// decode --channel: the burst is on channel 2, channel 1 holds only noise. The default reads
+// channel 1 and finds nothing (and says which channel of how many it read); --channel 2 finds
+// the bursts; the JSON carries both; a channel the file lacks exits 2 with nothing on stdout.
+TEST(DecodeCli, ChannelPicksTheColumnOrWavChannelThatHoldsTheSignal) {
+  const std::string dir = ::testing::TempDir() + "/capture_channel_" + std::to_string(::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write(dir + "/m.yaml",
+        "name: chan\ntransducers: {}\ngeometry:\n  distances_m: [0.5]\nexcitation:\n  family: M1\n  codes: [2]\n"
+        "noise:\n  noise_v: 0.001\n  seed: 3\n");
+  const ToolRun sim = run_tool("simulate " + dir + "/m.yaml --out " + dir + "/out --write-captures --quiet");
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const Capture k = read_capture(dir + "/out/captures/M1_500mm_r1_j2.wav");
+  double peak = 0;
+  for (double v : k.samples) peak = std::max(peak, std::abs(v));
+  ASSERT_GT(peak, 0.0);
+  std::vector<std::vector<double>> ch(2);
+  unsigned s = 12345;
+  for (double v : k.samples) {
+    s = s * 1103515245u + 12345u;
+    ch[0].push_back(0.01 * ((s >> 16) % 2001 - 1000.0) / 1000.0);  // noise only
+    ch[1].push_back(0.5 * v / peak);
+  }
+  write(dir + "/two.wav", wav16(ch, static_cast<std::uint32_t>(k.sample_rate)));
+  std::string csv = "TIME,CH1,CH2\n";
+  for (std::size_t n = 0; n < ch[0].size(); ++n) {
+    csv += sci(static_cast<double>(n) / k.sample_rate) + "," + sci(ch[0][n]) + "," + sci(ch[1][n]) + "\n";
+  }
+  write(dir + "/two.csv", csv);
+  for (const char* ext : {".wav", ".csv"}) {
+    SCOPED_TRACE(ext);
+    const std::string f = dir + "/two" + ext;
+    const ToolRun one = run_tool("decode " + f + " --family M1");
+    EXPECT_EQ(one.status, 1) << one.out << one.err;  // noise on channel 1: no burst passes the gate
+    EXPECT_NE(one.out.find("channel 1 of 2"), std::string::npos) << one.out;
+    const ToolRun two = run_tool("decode " + f + " --family M1 --channel 2 --json");
+    ASSERT_EQ(two.status, 0) << two.err;
+    const auto j = nlohmann::json::parse(two.out);
+    EXPECT_EQ(j["channel"], 2);
+    EXPECT_EQ(j["channels"], 2);
+    ASSERT_EQ(j["detections"].size(), 1u) << two.out;
+    EXPECT_EQ(j["detections"][0]["code"], 2);
+    EXPECT_NEAR(j["detections"][0]["distance_m"].get<double>(), 0.5, 2e-3);
+    const ToolRun bad = run_tool("decode " + f + " --family M1 --channel 3");
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_TRUE(bad.out.empty()) << bad.out;
+    EXPECT_NE(bad.err.find("channel 3"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("valid 1..2"), std::string::npos) << bad.err;
+  }
 }

@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
 
 #include <unistd.h>
 
@@ -176,6 +179,81 @@ TEST(StreamingDecode, SamplesAndMetadataAsReadCapture) {
     EXPECT_EQ(src.meta().family, whole.meta.family);
     EXPECT_EQ(src.meta().period_s, whole.meta.period_s);
     EXPECT_EQ(src.meta().source, whole.meta.source);
+  }
+}
+
+// Every channel of a 3-column CSV (each separator) and of a stereo float WAV streams as
+// read_capture reads it; a channel the file lacks is refused with read_capture's message.
+TEST(StreamingDecode, EveryChannelStreamsAsReadCaptureReadsIt) {
+  std::string csv = "TIME,CH1,CH2,CH3\n";
+  for (int n = 0; n < 1000; ++n) {
+    char row[128];
+    std::snprintf(row, sizeof row, "%.9e,%.6e,%.6e,%.6e\n", n * 2e-7, std::sin(0.1 * n), -0.5 * std::cos(0.2 * n),
+                  n / 1000.0);
+    csv += row;
+  }
+  std::vector<std::pair<std::string, std::string>> files = {{"ch.csv", csv}};
+  for (const char sep : {';', '\t', ' '}) {
+    std::string t = csv;
+    std::replace(t.begin(), t.end(), ',', sep);
+    files.emplace_back(std::string("ch_") + (sep == ';' ? "semi" : sep == '\t' ? "tab" : "space") + ".csv", t);
+  }
+  // stereo 32-bit float WAV: frames of (a, b)
+  std::string wav = capture_wav(capture(), WavFormat::Float32);
+  {
+    const std::string body = wav.substr(44);
+    std::string stereo;
+    for (std::size_t i = 0; i + 4 <= body.size(); i += 4) {
+      stereo += body.substr(i, 4);
+      float x;
+      std::memcpy(&x, body.data() + i, 4);
+      x = -2.0f * x;
+      char b[4];
+      std::memcpy(b, &x, 4);
+      stereo.append(b, 4);
+    }
+    auto put32 = [&](std::size_t at, std::uint32_t v) {
+      for (int k = 0; k < 4; ++k) wav[at + static_cast<std::size_t>(k)] = static_cast<char>((v >> (8 * k)) & 0xff);
+    };
+    wav = wav.substr(0, 44) + stereo;
+    put32(4, static_cast<std::uint32_t>(wav.size() - 8));
+    wav[22] = 2;                                                   // channels
+    put32(28, static_cast<std::uint32_t>(capture().sample_rate) * 8);  // byte rate
+    wav[32] = 8;                                                   // block align
+    put32(40, static_cast<std::uint32_t>(stereo.size()));
+  }
+  files.emplace_back("stereo.wav", wav);
+  for (const auto& [name, bytes] : files) {
+    const std::string p = write(name, bytes);
+    const int channels = name.ends_with(".wav") ? 2 : 3;
+    for (int ch = 1; ch <= channels; ++ch) {
+      SCOPED_TRACE(name + " channel " + std::to_string(ch));
+      const Capture whole = read_capture(p, ch);
+      CaptureSource src(p, ch);
+      EXPECT_EQ(src.channels(), channels);
+      EXPECT_EQ(whole.channels, channels);
+      std::vector<double> all, block(97);
+      for (std::size_t k; (k = src.read(block)) > 0;) all.insert(all.end(), block.begin(), block.begin() + static_cast<long>(k));
+      EXPECT_EQ(all, whole.samples);
+      if (ch == 2 && name.ends_with(".wav")) {
+        const Capture first = read_capture(p, 1);
+        ASSERT_EQ(first.samples.size(), whole.samples.size());
+        for (std::size_t n = 0; n < first.samples.size(); ++n) ASSERT_EQ(whole.samples[n], -2.0 * first.samples[n]);
+      }
+    }
+    std::string a, b;
+    try {
+      (void)read_capture(p, channels + 1);
+    } catch (const InputError& e) {
+      a = e.what();
+    }
+    try {
+      CaptureSource s(p, channels + 1);
+    } catch (const InputError& e) {
+      b = e.what();
+    }
+    EXPECT_NE(a.find("valid 1.." + std::to_string(channels)), std::string::npos) << name << ": " << a;
+    EXPECT_EQ(a, b) << name;
   }
 }
 

@@ -102,6 +102,7 @@ int cmd_decode(const Args& args) {
   cli::Parser p = command_parser("decode");
   p.positional("CAPTURE", "capture file (.csv or .wav)");
   add_family_option(p, "the one the transmitter used; default: the capture's metadata");
+  p.option("--channel", "N", "the channel to decode, 1..65535: a WAV's Nth channel, a CSV's column N + 1 (the first is the time); the --calibrate capture is read on the same channel", "1");
   p.option("--references", "DIR", "recorded reference bursts DIR/<family>-<j>.csv|.wav for the Pearson decoder");
   add_speed_of_sound_option(p, "the capture's metadata, else 340");
   p.option("--temperature", "C", "air temperature -40..60 C: speed of sound at 50 % RH, 101.325 kPa");
@@ -118,8 +119,9 @@ int cmd_decode(const Args& args) {
   const std::string path = p.positionals().at(0);
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
   const auto block = static_cast<std::size_t>(p.integer("--block-samples", 1 << 20, 64, 1 << 26));
+  const int channel = static_cast<int>(p.integer("--channel", 1, 1, 65535));
   // Streamed (model/sim/capture_stream.hpp): validated whole at open, then read in blocks.
-  CaptureSource cap(path);
+  CaptureSource cap(path, channel);
   const CaptureMeta& meta = cap.meta();
   const std::string meta_src = "capture metadata (" + (meta.source.empty() ? path : meta.source) + ")";
 
@@ -209,7 +211,7 @@ int cmd_decode(const Args& args) {
   std::optional<LatencyCalibration> cal;
   if (p.has("--calibrate")) {
     const std::string cal_path = *p.get("--calibrate");
-    Capture k = read_capture(cal_path);
+    Capture k = read_capture(cal_path, channel);
     if (std::abs(check_rate(k.sample_rate, cal_path) - fs) > 1e-6 * fs) {
       throw InputError("option --calibrate: " + cal_path + " is sampled at " + std::to_string(k.sample_rate) +
                        " Hz, the capture at " + std::to_string(cap.sample_rate()) + " Hz");
@@ -242,7 +244,7 @@ int cmd_decode(const Args& args) {
     (d.rho_max >= min_rho ? dets : below).push_back(d);
   }
   if (p.has("--plot")) {  // the picture needs the whole capture in memory (decoding does not)
-    plot_decode(*p.get("--plot"), scene, family, read_capture(path), fs, dets, below);
+    plot_decode(*p.get("--plot"), scene, family, read_capture(path, channel), fs, dets, below);
   }
   const bool known = meta.code_sent && *meta.code_sent > 0;
   auto det_json = [&](const Detection& d) {
@@ -259,6 +261,8 @@ int cmd_decode(const Args& args) {
   if (p.has("--json")) {
     nlohmann::json j;
     j["sample_rate"] = cap.sample_rate();
+    j["channel"] = channel;
+    j["channels"] = cap.channels();
     j["family"] = family;
     j["family_source"] = family_source;
     j["speed_of_sound"] = c.value;
@@ -287,8 +291,11 @@ int cmd_decode(const Args& args) {
     std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s\n",
                  family.c_str(), family_source.c_str(), c.value, c.source.c_str(), period.value,
                  period.source.c_str());
-    std::printf("%s: %zu samples at %.6g MS/s, family %s, c = %.2f m/s%s\n", path.c_str(), cap.size(),
-                cap.sample_rate() / 1e6, family.c_str(), c.value, cal ? ", latency calibrated" : "");
+    const std::string chan = cap.channels() > 1 ? ", channel " + std::to_string(channel) + " of " +
+                                                      std::to_string(cap.channels())
+                                                : std::string();
+    std::printf("%s: %zu samples at %.6g MS/s%s, family %s, c = %.2f m/s%s\n", path.c_str(), cap.size(),
+                cap.sample_rate() / 1e6, chan.c_str(), family.c_str(), c.value, cal ? ", latency calibrated" : "");
     std::printf("%5s %12s %12s %8s %8s\n", "code", "tof_us", "distance_mm", "rho_max", "margin");
     for (const auto& d : dets) {
       std::printf("%5d %12.3f %12.3f %8.4f %8.4f\n", d.code, d.tof_s * 1e6, d.tof_s * c.value * 1e3, d.rho_max,

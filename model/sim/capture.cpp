@@ -25,14 +25,17 @@ char csv_separator(const std::string& line) {
   return '\0';
 }
 
-double csv_row_value(const std::string& line) {
+double csv_row_value(const std::string& line, int channel) {
   const char sep = csv_separator(line);
   const char* p = line.c_str();
-  if (sep != '\0') {
-    p += line.find(sep) + 1;
-  } else {  // whitespace-separated: past the first token
-    while (*p == ' ' || *p == '\t') ++p;
-    while (*p != '\0' && *p != ' ' && *p != '\t') ++p;
+  for (int c = 0; c < channel; ++c) {  // past `channel` cells (the time and the channels before)
+    if (sep != '\0') {
+      while (*p != '\0' && *p != sep) ++p;
+      if (*p == sep) ++p;
+    } else {  // whitespace-separated: past the next token
+      while (*p == ' ' || *p == '\t') ++p;
+      while (*p != '\0' && *p != ' ' && *p != '\t') ++p;
+    }
   }
   while (*p == ' ' || *p == '\t' || *p == '"') ++p;
   return std::strtod(p, nullptr);
@@ -173,7 +176,9 @@ CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& 
   return m;
 }
 
-CsvCaptureScan::CsvCaptureScan(std::string origin) : origin_(std::move(origin)) {}
+CsvCaptureScan::CsvCaptureScan(std::string origin, int channel) : origin_(std::move(origin)), channel_(channel) {
+  if (channel < 1) throw InputError(origin_ + ": channel " + std::to_string(channel) + " is out of range; valid >= 1");
+}
 
 bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
   ++lineno_;
@@ -192,18 +197,26 @@ bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
     if (cells.size() >= 2) read_meta_line(meta_, cells[0], cells[1], origin_, lineno_);
     return false;
   }
-  if (!data_) first_data_line_ = lineno_;
+  if (!data_) {
+    first_data_line_ = lineno_;
+    channels_ = static_cast<int>(std::max<std::size_t>(cells.size(), 1) - 1);
+  }
   data_ = true;
+  const auto ch = static_cast<std::size_t>(channel_);
   if (cells.size() < 2) fail_at(origin_, lineno_, "expected 'time,voltage', found one column");
+  if (cells.size() < ch + 1) {
+    fail_at(origin_, lineno_, "channel " + std::to_string(channel_) + " (column " + std::to_string(channel_ + 1) +
+                                  ") is out of range: the row has " + std::to_string(cells.size() - 1) +
+                                  " channel(s); valid 1.." + std::to_string(cells.size() - 1));
+  }
   double val[2];
   for (int c = 0; c < 2; ++c) {
-    const std::string& cell = cells[static_cast<std::size_t>(c)];
-    if (!parse_number(cell, val[c])) {
-      fail_at(origin_, lineno_, std::string(c == 0 ? "time" : "voltage") + " column: '" + cell + "' is not a number");
-    }
+    const std::string& cell = cells[c == 0 ? 0 : ch];
+    const std::string what = c == 0 ? std::string("time") : channel_ == 1 ? std::string("voltage")
+                                                                          : "channel " + std::to_string(channel_);
+    if (!parse_number(cell, val[c])) fail_at(origin_, lineno_, what + " column: '" + cell + "' is not a number");
     if (!std::isfinite(val[c])) {
-      fail_at(origin_, lineno_, std::string(c == 0 ? "time" : "voltage") + " column: '" + cell +
-                                    "' is not finite (NaN or Inf)");
+      fail_at(origin_, lineno_, what + " column: '" + cell + "' is not finite (NaN or Inf)");
     }
   }
   if (rows_ > 0 && !(val[0] > t_last_)) {
@@ -249,8 +262,8 @@ void CsvCaptureScan::check_grid(std::size_t n, double t, std::size_t line) const
   }
 }
 
-Capture parse_capture_csv(const std::string& text, const std::string& origin) {
-  CsvCaptureScan scan(origin);
+Capture parse_capture_csv(const std::string& text, const std::string& origin, int channel) {
+  CsvCaptureScan scan(origin, channel);
   std::vector<double> t, v;
   std::vector<std::size_t> lines;
   std::stringstream in(text);
@@ -269,6 +282,8 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin) {
   c.t0 = scan.t0();
   c.meta = scan.meta();
   c.samples = std::move(v);
+  c.channel = channel;
+  c.channels = scan.channels();
   return c;
 }
 
@@ -290,7 +305,8 @@ std::uint16_t le16(const std::string& b, std::size_t at) {
 }  // namespace
 
 WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::size_t)>& bytes,
-                           std::size_t file_size, const std::string& origin) {
+                           std::size_t file_size, const std::string& origin, int channel) {
+  if (channel < 1) fail_wav(origin, 0, "channel " + std::to_string(channel) + " is out of range; valid >= 1");
   if (file_size == 0) fail_wav(origin, 0, "empty file");
   const std::string head = bytes(0, std::min<std::size_t>(12, file_size));
   if (head.size() < 12 || head.compare(0, 4, "RIFF") != 0 || head.compare(8, 4, "WAVE") != 0) {
@@ -334,7 +350,13 @@ WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::siz
       w.rate = rate;
       w.flt = flt;
       w.bits = bits;
+      if (static_cast<unsigned>(channel) > channels) {
+        fail_wav(origin, at, "channel " + std::to_string(channel) + " is out of range: the file has " +
+                                 std::to_string(channels) + " channel(s); valid 1.." + std::to_string(channels));
+      }
       w.frame = static_cast<std::size_t>(bits / 8u) * channels;
+      w.channels = channels;
+      w.offset = static_cast<std::size_t>(bits / 8u) * static_cast<std::size_t>(channel - 1);
       w.body = body;
       w.chunk_at = at;
       if (body + size > file_size) {
@@ -353,7 +375,7 @@ WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::siz
 void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const std::string& origin, std::size_t i0,
                  double* out) {
   const std::size_t f = w.frame;
-  const auto* u = reinterpret_cast<const unsigned char*>(p);
+  const auto* u = reinterpret_cast<const unsigned char*>(p) + w.offset;
   auto le = [](const unsigned char* b, int n) {  // n little-endian bytes
     std::uint64_t v = 0;
     for (int i = n - 1; i >= 0; --i) v = (v << 8) | b[i];
@@ -361,7 +383,7 @@ void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const st
   };
   auto not_finite = [&](std::size_t k) {
     const std::size_t i = i0 + k;
-    fail_wav(origin, w.body + i * w.frame, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
+    fail_wav(origin, w.body + i * w.frame + w.offset, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
   };
   if (w.flt && w.bits == 32) {
     for (std::size_t k = 0; k < frames; ++k, u += f) {
@@ -398,10 +420,12 @@ void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const st
   }
 }
 
-Capture parse_capture_wav(const std::string& b, const std::string& origin) {
+Capture parse_capture_wav(const std::string& b, const std::string& origin, int channel) {
   const WavLayout w = parse_wav_layout([&](std::size_t at, std::size_t len) { return b.substr(at, len); }, b.size(),
-                                       origin);
+                                       origin, channel);
   Capture c;
+  c.channel = channel;
+  c.channels = static_cast<int>(w.channels);
   c.sample_rate = w.rate;
   c.samples.resize(w.n);
   wav_samples(b.data() + w.body, w.n, w, origin, 0, c.samples.data());
@@ -428,7 +452,7 @@ void merge_capture_sidecar(CaptureMeta& o, const std::string& path) {
   }
 }
 
-Capture read_capture(const std::string& path) {
+Capture read_capture(const std::string& path, int channel) {
   std::string ext;
   if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
@@ -436,7 +460,7 @@ Capture read_capture(const std::string& path) {
     throw InputError(path + ": unknown capture type '." + ext + "'; valid: .csv (oscilloscope export), .wav");
   }
   const std::string bytes = read_input_file(path, "capture file", std::size_t{1} << 30);
-  Capture c = ext == "csv" ? parse_capture_csv(bytes, path) : parse_capture_wav(bytes, path);
+  Capture c = ext == "csv" ? parse_capture_csv(bytes, path, channel) : parse_capture_wav(bytes, path, channel);
   merge_capture_sidecar(c.meta, path);
   return c;
 }

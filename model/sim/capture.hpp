@@ -4,15 +4,17 @@
 //
 // CSV: optional header lines (anything before the first row whose first cell is a number,
 // e.g. a Tektronix export's "Record Length,..." lines and its "TIME,CH1" line), then rows
-// "time_s,volts[,more columns ignored]", or separated by ';', tabs or spaces (a line with a ';' is
+// "time_s,volts[,more channels]" (channel N is column N + 1), or separated by ';', tabs or spaces (a line with a ';' is
 // split on ';', else one with a ',' on ',', else on runs of whitespace: numpy.savetxt, SPICE and
 // European exports; decimal commas are refused). Time must increase with an even step (every
 // sample within 2 % of a step of the uniform grid from the first to the last time); the sample rate
 // is the number of steps over the time span. t0 is the time of the first row (the scope's
 // pre-trigger makes it negative), t = 0 being the start of transmission of the first burst.
 // WAV: RIFF/WAVE, 8-bit (unsigned), 16-, 24- or 32-bit PCM, or 32- or 64-bit IEEE float (also
-// as WAVE_FORMAT_EXTENSIBLE), mono or the first channel of several; t0 = 0; PCM values are read
+// as WAVE_FORMAT_EXTENSIBLE), mono or one channel of several (interleaved frames); t0 = 0; PCM values are read
 // as full-scale fractions (code / 2^(bits-1), 8-bit as (code - 128) / 128).
+// Channels: the readers take a 1-based channel (default 1) and report how many the file has
+// (CSV: the value columns of the first data row; every data row must hold the channel read).
 // Every error is an InputError naming the file and line (CSV) or byte offset (WAV).
 //
 // Metadata (what `simulate --write-captures` knows about the stream), all optional:
@@ -48,16 +50,20 @@ struct Capture {
   double t0 = 0;                 // time of samples[0], s (0 = start of the first burst)
   std::vector<double> samples;   // volts (CSV, float WAV) or full-scale fractions (PCM WAV)
   CaptureMeta meta;
+  int channel = 1;               // the channel read (1-based)
+  int channels = 1;              // how many the file has
 };
 
 // The sidecar JSON's text for meta, and its parse (InputError naming origin and the key).
 std::string capture_meta_json(const CaptureMeta& meta);
 CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& origin);
 
-// By extension: .csv or .wav (case-insensitive); anything else is refused.
-Capture read_capture(const std::string& path);
-Capture parse_capture_csv(const std::string& text, const std::string& origin);
-Capture parse_capture_wav(const std::string& bytes, const std::string& origin);
+// By extension: .csv or .wav (case-insensitive); anything else is refused. channel: 1-based;
+// one the file does not have is an InputError naming the file, the line (CSV) or byte (WAV),
+// and the valid range.
+Capture read_capture(const std::string& path, int channel = 1);
+Capture parse_capture_csv(const std::string& text, const std::string& origin, int channel = 1);
+Capture parse_capture_wav(const std::string& bytes, const std::string& origin, int channel = 1);
 
 enum class WavFormat { Pcm8, Pcm16, Pcm24, Pcm32, Float32, Float64 };
 

@@ -15,7 +15,7 @@ namespace {
 constexpr std::size_t kWavBlockBytes = std::size_t{1} << 20;
 }
 
-CaptureSource::CaptureSource(const std::string& path) : path_(path) {
+CaptureSource::CaptureSource(const std::string& path, int channel) : path_(path), channel_(channel) {
   std::string ext;
   if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
@@ -33,7 +33,7 @@ CaptureSource::CaptureSource(const std::string& path) : path_(path) {
   if (!in_) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
   const std::size_t file_size = static_cast<std::size_t>(fs::file_size(path, ec));
   if (csv_) {
-    CsvCaptureScan scan(path);
+    CsvCaptureScan scan(path, channel);
     std::string line;
     double t = 0, v = 0;
     while (std::getline(in_, line)) (void)scan.line(line, t, v);
@@ -42,7 +42,7 @@ CaptureSource::CaptureSource(const std::string& path) : path_(path) {
     // Second pass: every row on the uniform grid (the rows are known to be well formed now).
     in_.clear();
     in_.seekg(0);
-    CsvCaptureScan again(path);
+    CsvCaptureScan again(path, channel);
     std::size_t n = 0;
     while (std::getline(in_, line)) {
       if (again.line(line, t, v)) scan.check_grid(n++, t, again.lineno());
@@ -52,6 +52,7 @@ CaptureSource::CaptureSource(const std::string& path) : path_(path) {
     n_ = scan.rows();
     meta_ = scan.meta();
     first_data_line_ = scan.first_data_line();
+    channels_ = scan.channels();
   } else {
     wav_ = parse_wav_layout(
         [&](std::size_t at, std::size_t len) {
@@ -62,7 +63,8 @@ CaptureSource::CaptureSource(const std::string& path) : path_(path) {
           b.resize(static_cast<std::size_t>(std::max<std::streamsize>(in_.gcount(), 0)));
           return b;
         },
-        file_size, path);
+        file_size, path, channel);
+    channels_ = static_cast<int>(wav_.channels);
     rate_ = wav_.rate;
     n_ = wav_.n;
     if (wav_.flt || n_ < 2) {  // NaN/Inf are refused before anything is decoded (read_capture's order)
@@ -97,8 +99,8 @@ std::size_t CaptureSource::read(std::span<double> out) {
     while (k < out.size() && pos_ < n_ && std::getline(in_, line)) {
       ++lineno_;
       if (lineno_ < first_data_line_) continue;
-      // The rows were validated at open: the second cell is a finite number.
-      out[k++] = csv_row_value(line);
+      // The rows were validated at open: the channel's cell is a finite number.
+      out[k++] = csv_row_value(line, channel_);
       ++pos_;
     }
     if (k < out.size() && pos_ < n_) throw InputError(path_ + ": changed while it was read (fewer rows than at open)");

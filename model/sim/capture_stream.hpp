@@ -26,13 +26,15 @@
 namespace ranging {
 
 // A CSV line's separator: ';' if it has one, else ',' if it has one, else '\0' (runs of tabs
-// and spaces). csv_row_value: the second cell of a data row that CsvCaptureScan validated.
+// and spaces). csv_row_value: cell `channel` (0 is the time) of a data row that CsvCaptureScan
+// validated.
 char csv_separator(const std::string& line);
-double csv_row_value(const std::string& line);
+double csv_row_value(const std::string& line, int channel = 1);
 
 class CsvCaptureScan {
  public:
-  explicit CsvCaptureScan(std::string origin);
+  // channel: the 1-based value column read (column channel + 1 of each row)
+  explicit CsvCaptureScan(std::string origin, int channel = 1);
   // One line of the file (without its newline): true for a data row (t, v set).
   bool line(const std::string& text, double& t, double& v);
   void finish();  // after the last line: the file-level checks; sample_rate() and t0() valid after it
@@ -43,9 +45,11 @@ class CsvCaptureScan {
   double sample_rate() const { return 1.0 / dt_; }
   double t0() const { return t_first_; }
   const CaptureMeta& meta() const { return meta_; }
+  int channels() const { return channels_; }  // value columns of the first data row
 
  private:
   std::string origin_;
+  int channel_ = 1, channels_ = 0;
   CaptureMeta meta_;
   std::size_t lineno_ = 0, rows_ = 0, first_data_line_ = 0, last_data_line_ = 0, record_line_ = 0;
   bool data_ = false;
@@ -57,14 +61,17 @@ struct WavLayout {
   bool flt = false;
   unsigned bits = 0;
   std::size_t frame = 0;     // bytes per frame (all channels)
+  unsigned channels = 1;     // channels per frame
+  std::size_t offset = 0;    // byte offset of the channel read within a frame
   std::size_t body = 0;      // byte offset of the first sample
   std::size_t chunk_at = 0;  // byte offset of the data chunk header
   std::size_t n = 0;         // frames
 };
 // bytes(at, len): len bytes of the file from offset at (fewer at its end).
+// channel: 1-based, the one wav_samples reads (InputError at the data chunk if the file lacks it).
 WavLayout parse_wav_layout(const std::function<std::string(std::size_t, std::size_t)>& bytes, std::size_t file_size,
-                           const std::string& origin);
-// frames consecutive frames from p (frame i0 first) into out, each its first channel as a
+                           const std::string& origin, int channel = 1);
+// frames consecutive frames from p (frame i0 first) into out, each the layout's channel as a
 // full-scale fraction (PCM) or the float value, the format's branch taken once per block;
 // InputError naming the frame on NaN/Inf.
 void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const std::string& origin, std::size_t i0,
@@ -75,8 +82,11 @@ void merge_capture_sidecar(CaptureMeta& meta, const std::string& path);
 
 class CaptureSource {
  public:
-  explicit CaptureSource(const std::string& path);  // validates the whole file (InputError)
+  // Validates the whole file (InputError); channel: 1-based, as read_capture.
+  explicit CaptureSource(const std::string& path, int channel = 1);
   ~CaptureSource();
+  int channels() const { return channels_; }  // how many the file has
+  int channel() const { return channel_; }
   double sample_rate() const { return rate_; }
   double t0() const { return t0_; }
   std::size_t size() const { return n_; }
@@ -89,6 +99,7 @@ class CaptureSource {
  private:
   std::string path_;
   bool csv_ = false;
+  int channel_ = 1, channels_ = 1;
   double rate_ = 0, t0_ = 0;
   std::size_t n_ = 0, pos_ = 0;
   CaptureMeta meta_;
