@@ -227,7 +227,7 @@ TEST(DecodeCli, DecodesSimulatedCapturesBackToTheSimulatedResults) {
 }
 
 // A capture at 4 MS/s (a common scope rate that does not divide the 30 MHz receiver clock) is
-// decoded: the receiver's clock moves to 32 MHz with a warning on stderr, the code and distance
+// decoded: the receiver's clock moves to 36 MHz (the next multiple the board's PLL makes) with a warning on stderr, the code and distance
 // are the simulated ones.
 TEST(DecodeCli, ACaptureWhoseRateDoesNotDivideTheClockDecodes) {
   const std::string dir = ::testing::TempDir() + "/capture_4ms_" + std::to_string(::getpid());
@@ -237,10 +237,10 @@ TEST(DecodeCli, ACaptureWhoseRateDoesNotDivideTheClockDecodes) {
                          "excitation:\n  family: Gold4\n  codes: [5]\nnoise:\n  noise_v: 0.002\n");
   const ToolRun sim = run_tool("simulate " + dir + "/s.yaml --out " + dir + "/out --write-captures --quiet --json");
   ASSERT_EQ(sim.status, 0) << sim.err;
-  EXPECT_NE(sim.err.find("the receiver's clock is 32 MHz (8 clocks per sample)"), std::string::npos) << sim.err;
+  EXPECT_NE(sim.err.find("the receiver's clock is 36 MHz (9 clocks per sample"), std::string::npos) << sim.err;
   const ToolRun dec = run_tool("decode " + dir + "/out/captures/Gold4_600mm_r1_j5.wav --family Gold4 --json");
   ASSERT_EQ(dec.status, 0) << dec.err;
-  EXPECT_NE(dec.err.find("the receiver's clock is 32 MHz"), std::string::npos) << dec.err;
+  EXPECT_NE(dec.err.find("the receiver's clock is 36 MHz"), std::string::npos) << dec.err;
   const auto j = nlohmann::json::parse(dec.out);
   EXPECT_EQ(j["sample_rate"], 4e6);
   ASSERT_GE(j["detections"].size(), 1u) << dec.out;

@@ -13,7 +13,10 @@
 #include <memory>
 
 #include "model/base/error.hpp"
+#include "model/config/ice40_pll.hpp"
 #include "model/dsp/filter_design.hpp"
+#include "model/dsp/receiver.hpp"
+#include "model/hw/hw_system.hpp"
 #include "model/sim/medium.hpp"
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
@@ -143,10 +146,14 @@ TEST(SceneSimulator, DeterministicForASeedAndTheSeedMatters) {
 }
 
 // A sample rate that does not divide the configuration's 30 MHz clock (a 4 MS/s or 20 MS/s
-// scope) gets the next multiple as the receiver's clock, with a warning, and decodes; a rate that
-// divides it keeps the clock and says nothing.
+// scope) gets the next multiple as the receiver's clock that the system can run at (the board's
+// PLL makes it from 12 MHz, the 1.5 Mbaud UART divides it: 32 and 40 MHz are not made by the PLL),
+// with a warning, and decodes; the system files (PLL, UART divider) generate for it, so the RTL
+// and bitstream flows take it; a rate that divides it keeps the clock and says nothing.
 TEST(SceneSimulator, ASampleRateThatDoesNotDivideTheClockMovesTheClockAndDecodes) {
-  for (const auto& [rate, clock] : {std::pair{4e6, 32e6}, std::pair{20e6, 40e6}, std::pair{5e6, 30e6}}) {
+  EXPECT_FALSE(find_ice40_pll(12e6, 32e6));
+  EXPECT_FALSE(find_ice40_pll(12e6, 40e6));
+  for (const auto& [rate, clock] : {std::pair{4e6, 36e6}, std::pair{20e6, 60e6}, std::pair{5e6, 30e6}}) {
     std::ostringstream y;
     y << "sample_rate: " << rate << "\ntransducers: {}\ngeometry:\n  distances_m: [0.3, 0.8]\n"
       << "excitation:\n  family: Gold4\n  codes: [2, 7]\nnoise:\n  noise_v: 0.002\n";
@@ -158,7 +165,12 @@ TEST(SceneSimulator, ASampleRateThatDoesNotDivideTheClockMovesTheClockAndDecodes
     if (moved) {
       EXPECT_NE(scene.warnings[0].find("does not divide the receiver's hardware.clock_hz (30 MHz)"), std::string::npos)
           << scene.warnings[0];
+      EXPECT_NE(scene.warnings[0].find("that the board's PLL makes and system.baud divides)"), std::string::npos)
+          << scene.warnings[0];
     }
+    const auto files = generate_system_files(design_receiver(scene.receiver.config), "s.yaml");
+    EXPECT_NE(files.at("rtl/ice40_pll.vh").find("RANGING_CLK_HZ " + std::to_string(static_cast<long>(clock))),
+              std::string::npos);
     SceneSimulator sim(scene);
     const auto rows = sim.run("Gold4");
     ASSERT_EQ(rows.size(), 4u);
@@ -168,6 +180,31 @@ TEST(SceneSimulator, ASampleRateThatDoesNotDivideTheClockMovesTheClockAndDecodes
       EXPECT_LT(std::abs(r.error_m), 1e-3);
     }
   }
+}
+
+// A receiver configuration file whose signal keys differ from the scene's: the scene's win (the
+// receiver runs on the scene's ADC stream) and a warning names each replaced key; the same file
+// with matching keys gives no warning; the built-in configuration gives none either.
+TEST(Scene, AConfigurationFilesSignalKeysReplacedByTheScenesAreNamed) {
+  const std::string dir = ::testing::TempDir() + "/scene_cfg_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/mine.yaml") << "name: mine\nsignal:\n  fs: 4000000\n  cycles_per_chip: 2\n"
+                                       "correlator:\n  decimation: 10\nhardware:\n  clock_hz: 24000000\n";
+  std::ofstream(dir + "/same.yaml") << "name: same\n";
+  const std::string body = "transducers: {}\ngeometry:\n  distances_m: [0.5]\nexcitation:\n  family: M1\n";
+  std::ofstream(dir + "/s.yaml") << body << "receiver:\n  config: mine.yaml\n";
+  std::ofstream(dir + "/t.yaml") << body << "receiver:\n  config: same.yaml\n";
+  const Scene s = load_scene(dir + "/s.yaml");
+  ASSERT_GE(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("the scene's values replace receiver.config mine.yaml's signal.fs 4 MS/s -> "
+                               "sample_rate 5 MS/s, signal.cycles_per_chip 2 -> excitation.cycles_per_chip 4"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_EQ(s.receiver.config.fs, 5e6);
+  EXPECT_EQ(s.receiver.config.cycles_per_chip, 4);
+  EXPECT_EQ(s.receiver.config.clock_hz, 30e6);  // 24 MHz moved: 25 MHz is not made by the PLL
+  EXPECT_TRUE(load_scene(dir + "/t.yaml").warnings.empty());
+  EXPECT_TRUE(parse_scene(body, "u.yaml").warnings.empty());
 }
 
 TEST(SceneSimulator, StagesChangeTheSignalAsTheyShould) {

@@ -46,29 +46,6 @@ std::uint32_t speed_register(double c, double fs, int c_frac) {
   return static_cast<std::uint32_t>(v);
 }
 
-Ice40Pll ice40_pll(double f_in, double f_out) {
-  for (int divr = 0; divr <= 15; ++divr) {
-    const double pfd = f_in / (divr + 1);
-    if (pfd < 10e6 || pfd > 133e6) continue;
-    for (int divf = 0; divf <= 127; ++divf) {
-      const double vco = pfd * (divf + 1);
-      if (vco < 533e6 || vco > 1066e6) continue;
-      for (int divq = 1; divq <= 6; ++divq) {
-        const double out = vco / static_cast<double>(1 << divq);
-        if (std::abs(out - f_out) > 1e-3) continue;
-        Ice40Pll p{divr, divf, divq, 0, pfd, vco, out};
-        // icepll's loop filter ranges by F_PFD
-        p.filter_range = pfd < 17e6 ? 1 : pfd < 26e6 ? 2 : pfd < 44e6 ? 3 : pfd < 66e6 ? 4 : pfd < 101e6 ? 5 : 6;
-        return p;
-      }
-    }
-  }
-  std::ostringstream os;
-  os << "clk_hz: " << f_out << " Hz cannot be made exactly from the " << f_in
-     << " Hz oscillator by the iCE40 PLL (e.g. 30 MHz or 45 MHz from 12 MHz can)";
-  throw InputError(os.str());
-}
-
 SystemOptions system_options(const ReceiverConfig& c) {
   SystemOptions o;
   static_cast<SystemConfig&>(o) = c.system;
@@ -307,7 +284,7 @@ std::map<std::string, std::string> generate_system_files(const ReceiverDesign& d
   j["frac_bits"] = s.frac_w;
   j["offsets"] = s.offsets;
   // The board's PLL (boards/icebreaker/ice40_top.v includes this file).
-  const Ice40Pll pll = ice40_pll(12e6, s.clk_hz);
+  const Ice40Pll pll = ice40_pll(kBoardOscillatorHz, s.clk_hz);
   std::ostringstream vh;
   vh << head << "// iCEBreaker SB_PLL40_PAD settings: 12 MHz -> " << pll.f_out / 1e6 << " MHz (F_PFD "
      << pll.f_pfd / 1e6 << " MHz, F_VCO " << pll.f_vco / 1e6 << " MHz), as `icepll -i 12 -o " << s.clk_hz / 1e6

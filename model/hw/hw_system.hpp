@@ -3,6 +3,7 @@
 // the configuration-derived parameters of the transmit scheduler, ADC clock, time of flight and
 // UART, the bit-exact model of rtl/tof_distance.v, and the generated system top
 // (rtl/ranging_system_top.v with literal parameters, and its Verilator -G file).
+#include "model/config/ice40_pll.hpp"
 #include <cstdint>
 #include <map>
 #include <string>
@@ -73,14 +74,7 @@ class TofDistanceModel {
 std::vector<std::int8_t> system_drive(const ReceiverDesign& design, const SystemDesign& s,
                                       std::size_t samples);
 
-// iCE40 SB_PLL40 settings (SIMPLE feedback) that make f_out from f_in exactly, searched like
-// icestorm's icepll: F_PFD = f_in / (DIVR+1) in [10, 133] MHz, F_VCO = F_PFD (DIVF+1) in
-// [533, 1066] MHz, f_out = F_VCO / 2^DIVQ. Throws InputError naming clk_hz when none is exact.
-struct Ice40Pll {
-  int divr = 0, divf = 0, divq = 0, filter_range = 0;
-  double f_pfd = 0, f_vco = 0, f_out = 0;
-};
-Ice40Pll ice40_pll(double f_in, double f_out);
+// ice40_pll (the board's PLL settings): model/config/ice40_pll.hpp.
 
 // Generated files (relative to the generator's output folder): rtl/ranging_system_top.v,
 // rtl/ranging_system.vc, rtl/ice40_pll.vh (the iCEBreaker PLL: 12 MHz -> clk_hz), system.json.

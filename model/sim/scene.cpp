@@ -1,3 +1,4 @@
+#include "model/config/ice40_pll.hpp"
 #include "model/config/receiver_config.hpp"
 #include "model/sim/scene.hpp"
 
@@ -209,6 +210,7 @@ void read_receiver(Reader& r, Scene& s, const std::string& base_dir, const Overr
   std::string cfg;
   if (r.get("config", cfg)) {
     rc.config = config_errors([&] { return load_receiver_config(beside(base_dir, cfg), config_overrides, allow_out_of_spec); });
+    rc.config_file = cfg;
     config_loaded = true;
   }
   if (config_loaded) s.effective_config_yaml = receiver_config_yaml(rc.config);
@@ -251,24 +253,56 @@ void read_receiver(Reader& r, Scene& s, const std::string& base_dir, const Overr
 // bad scene fails at load time, naming the file.
 void derive_receiver_config(Scene& s, const YAML::Node& root, const std::string& origin, bool allow_out_of_spec) {
   auto& rc = s.receiver.config;
+  // A configuration file's signal keys give way to the scene's (the receiver runs on the
+  // scene's ADC stream): said in a warning when they differ, so no setting is dropped quietly.
+  if (!s.receiver.config_file.empty()) {
+    std::ostringstream os;
+    os.precision(9);
+    auto differs = [](double a, double b) { return std::abs(a - b) > 1e-9 * std::abs(b); };
+    if (differs(rc.fs, s.fs)) os << ", signal.fs " << rc.fs / 1e6 << " MS/s -> sample_rate " << s.fs / 1e6 << " MS/s";
+    if (differs(rc.carrier_hz, s.excitation.carrier_hz)) {
+      os << ", signal.carrier_hz " << rc.carrier_hz << " -> excitation.carrier_hz " << s.excitation.carrier_hz;
+    }
+    if (rc.cycles_per_chip != s.excitation.cycles_per_chip) {
+      os << ", signal.cycles_per_chip " << rc.cycles_per_chip << " -> excitation.cycles_per_chip "
+         << s.excitation.cycles_per_chip;
+    }
+    if (!os.str().empty()) {
+      s.warnings.push_back(s.origin + ": the scene's values replace receiver.config " + s.receiver.config_file + "'s" +
+                           os.str().substr(1));
+    }
+  }
   rc.carrier_hz = s.excitation.carrier_hz;
   rc.cycles_per_chip = s.excitation.cycles_per_chip;
   rc.fs = s.fs;
   rc.filter.fs = s.fs;
   // The hardware clock (the RTL's: clock_hz / fs clocks per sample, an integer) follows the
   // sample rate too: a scene rate that does not divide the configuration's clock (4, 4.8 or 20
-  // MS/s into 30 MHz) gets the next multiple of it, said in a warning. The model's results
-  // do not depend on the clock.
+  // MS/s into 30 MHz) gets the next multiple of it that the system can run at (the board's PLL
+  // makes it exactly and system.baud divides it, so the RTL and the bitstream flow accept it;
+  // else the next multiple), said in a warning. The model's results do not depend on the clock.
   if (const double per = rc.clock_hz / rc.fs;
       per > 0 && std::abs(per - std::round(per)) > 1e-9 * per && std::ceil(per) * rc.fs <= 500e6) {
+    double k = std::ceil(per);
+    bool system_ok = false;
+    for (double m = k; m * rc.fs <= 275e6 && !system_ok; ++m) {  // the iCE40 PLL's output tops out below 275 MHz
+      const double clk = m * rc.fs, div = clk / rc.system.baud;
+      if (find_ice40_pll(kBoardOscillatorHz, clk) && div >= 2 && std::abs(div - std::round(div)) <= 1e-9 * div) {
+        k = m;
+        system_ok = true;
+      }
+    }
     std::ostringstream os;
     os.precision(9);
     os << s.origin << ": sample_rate: " << s.fs / 1e6 << " MS/s does not divide the receiver's hardware.clock_hz ("
-       << rc.clock_hz / 1e6 << " MHz); the receiver's clock is " << std::ceil(per) * rc.fs / 1e6 << " MHz ("
-       << std::ceil(per) << " clocks per sample)";
+       << rc.clock_hz / 1e6 << " MHz); the receiver's clock is " << k * rc.fs / 1e6 << " MHz (" << k
+       << " clocks per sample"
+       << (system_ok ? ", the next multiple of the sample rate that the board's PLL makes and system.baud divides)"
+                     : "; no multiple up to 275 MHz is one that the board's PLL makes and system.baud divides: "
+                       "the RTL and the bitstream need a hardware.clock_hz that is)");
     s.warnings.push_back(os.str());
     s.moved_clock_from_hz = rc.clock_hz;
-    rc.clock_hz = std::ceil(per) * rc.fs;
+    rc.clock_hz = k * rc.fs;
   }
   rc.family = s.excitation.families.front();
   if (s.receiver.reference != "files") rc.reference = s.receiver.reference;

@@ -99,6 +99,7 @@ struct SceneMetrics {
 
 struct SceneReceiver {
   ReceiverConfig config;            // family/q/carrier/fs follow the excitation and the scene
+  std::string config_file;          // the receiver.config file it was read from ("": built in)
   std::string precision = "float";  // float | fixed
   std::string reference = "received";  // received | ideal | files (Pearson templates)
   std::string references_dir;       // reference = files
