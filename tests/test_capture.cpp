@@ -395,7 +395,7 @@ TEST(Capture, ChannelsOfAMultiColumnCsvAndAMultiChannelWav) {
       text += sci(n * 2e-7) + sep + sci(0.001 * n) + sep + sci(-0.25 * n) + sep + sci(7.0 + n) + "\n";
     }
     for (int ch = 1; ch <= 3; ++ch) {
-      const Capture c = parse_capture_csv(text, "scope.csv", ch);
+      const Capture c = parse_capture_csv(text, "scope.csv", {.channel = ch});
       EXPECT_EQ(c.channel, ch);
       EXPECT_EQ(c.channels, 3);
       ASSERT_EQ(c.samples.size(), 6u);
@@ -405,7 +405,7 @@ TEST(Capture, ChannelsOfAMultiColumnCsvAndAMultiChannelWav) {
       }
     }
     try {
-      (void)parse_capture_csv(text, "scope.csv", 4);
+      (void)parse_capture_csv(text, "scope.csv", {.channel = 4});
       ADD_FAILURE() << "channel 4 of a 3-channel CSV was read";
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("scope.csv:2: channel 4"), std::string::npos) << e.what();
@@ -414,16 +414,16 @@ TEST(Capture, ChannelsOfAMultiColumnCsvAndAMultiChannelWav) {
   }
   // A row shorter than the channel read is refused at its line; one channel 1 does not need is fine.
   const std::string ragged = "0,1,2\n2e-7,3\n4e-7,5,6\n";
-  EXPECT_EQ(parse_capture_csv(ragged, "r.csv", 1).samples.size(), 3u);
+  EXPECT_EQ(parse_capture_csv(ragged, "r.csv", {.channel = 1}).samples.size(), 3u);
   try {
-    (void)parse_capture_csv(ragged, "r.csv", 2);
+    (void)parse_capture_csv(ragged, "r.csv", {.channel = 2});
     ADD_FAILURE() << "a row without channel 2 was read";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("r.csv:2: channel 2"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(parse_capture_csv("0,1,nan\n2e-7,3,4\n", "n.csv", 1).samples.size(), 2u);  // channel 1 ignores column 3
+  EXPECT_EQ(parse_capture_csv("0,1,nan\n2e-7,3,4\n", "n.csv", {.channel = 1}).samples.size(), 2u);  // channel 1 ignores column 3
   try {
-    (void)parse_capture_csv("0,1,nan\n2e-7,3,4\n", "n.csv", 2);
+    (void)parse_capture_csv("0,1,nan\n2e-7,3,4\n", "n.csv", {.channel = 2});
     ADD_FAILURE() << "NaN in channel 2 was read";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("n.csv:1: channel 2 column: 'nan' is not finite"), std::string::npos)
@@ -439,7 +439,7 @@ TEST(Capture, ChannelsOfAMultiColumnCsvAndAMultiChannelWav) {
   }
   const std::string bytes = wav16(ch, 5000000);
   for (int k = 1; k <= 3; ++k) {
-    const Capture c = parse_capture_wav(bytes, "daq.wav", k);
+    const Capture c = parse_capture_wav(bytes, "daq.wav", {.channel = k});
     EXPECT_EQ(c.channels, 3);
     EXPECT_EQ(c.channel, k);
     ASSERT_EQ(c.samples.size(), 50u);
@@ -448,7 +448,7 @@ TEST(Capture, ChannelsOfAMultiColumnCsvAndAMultiChannelWav) {
     }
   }
   try {
-    (void)parse_capture_wav(bytes, "daq.wav", 4);
+    (void)parse_capture_wav(bytes, "daq.wav", {.channel = 4});
     ADD_FAILURE() << "channel 4 of a 3-channel WAV was read";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("daq.wav: byte 36: channel 4 is out of range"), std::string::npos) << e.what();
@@ -505,4 +505,73 @@ TEST(DecodeCli, ChannelPicksTheColumnOrWavChannelThatHoldsTheSignal) {
     EXPECT_NE(bad.err.find("channel 3"), std::string::npos) << bad.err;
     EXPECT_NE(bad.err.find("valid 1..2"), std::string::npos) << bad.err;
   }
+}
+
+// A given sample rate: a CSV of one column of samples (numpy.savetxt of an array) reads at it
+// from t = 0; without one it is refused, saying how to give it; a CSV with a time column refuses
+// one (its time sets the rate); a WAV's header rate is replaced by it.
+TEST(Capture, AGivenSampleRateReadsACsvOfSamplesAloneAndReplacesAWavHeadersRate) {
+  std::string one = "# numpy.savetxt header\n";
+  for (int n = 0; n < 40; ++n) one += sci(0.01 * std::sin(0.7 * n)) + "\n";
+  const Capture c = parse_capture_csv(one, "one.csv", {.sample_rate = 2.5e6});
+  EXPECT_EQ(c.sample_rate, 2.5e6);
+  EXPECT_EQ(c.t0, 0.0);
+  EXPECT_EQ(c.channels, 1);
+  EXPECT_EQ(c.file_rate, 0.0);
+  ASSERT_EQ(c.samples.size(), 40u);
+  for (int n = 0; n < 40; ++n) EXPECT_NEAR(c.samples[static_cast<std::size_t>(n)], 0.01 * std::sin(0.7 * n), 1e-11);
+  auto refused = [](const std::string& text, const CaptureRead& how, const std::string& want) {
+    try {
+      (void)parse_capture_csv(text, "x.csv", how);
+      ADD_FAILURE() << "accepted; expected: " << want;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
+  };
+  refused(one, {}, "x.csv:2: expected 'time,voltage', found one column (a CSV of samples alone is read with its "
+                   "sample rate given");
+  refused(one, {.channel = 2, .sample_rate = 2.5e6}, "x.csv:2: channel 2 is out of range: the rows have 1 channel");
+  refused("0.1\n0.2\n0.3,0.4\n", {.sample_rate = 1e6}, "x.csv:3: expected one column of samples (as the first data row), found 2");
+  refused("0.1\nnan\n", {.sample_rate = 1e6}, "x.csv:2: sample: 'nan' is not finite");
+  refused("0,0.1\n2e-7,0.2\n", {.sample_rate = 5e6}, "x.csv:1: a sample rate (5000000 Hz) was given, but the rows have a time column");
+  // WAV: the header says 44.1 kHz (a placeholder); the given rate replaces it, the samples are the same.
+  Capture w;
+  w.sample_rate = 44100;
+  w.samples = {0.1, -0.2, 0.3, -0.4};
+  const std::string bytes = capture_wav(w, WavFormat::Float32);
+  const Capture a = parse_capture_wav(bytes, "w.wav");
+  const Capture b = parse_capture_wav(bytes, "w.wav", {.sample_rate = 5e6});
+  EXPECT_EQ(a.sample_rate, 44100.0);
+  EXPECT_EQ(b.sample_rate, 5e6);
+  EXPECT_EQ(b.file_rate, 44100.0);
+  EXPECT_EQ(a.samples, b.samples);
+}
+
+// decode --sample-rate: the simulated capture written as numpy.savetxt writes an array decodes to
+// the same detection as the capture itself; the catalogue's refusals are in test_bad_input.
+TEST(DecodeCli, ACsvOfSamplesAloneDecodesWithItsSampleRateGiven) {
+  const std::string dir = ::testing::TempDir() + "/capture_rate_" + std::to_string(::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  write(dir + "/m.yaml",
+        "name: rate\ntransducers: {}\ngeometry:\n  distances_m: [0.7]\nexcitation:\n  family: M1\n  codes: [1]\n"
+        "noise:\n  noise_v: 0.001\n  seed: 5\n");
+  const ToolRun sim = run_tool("simulate " + dir + "/m.yaml --out " + dir + "/out --write-captures --quiet");
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const Capture k = read_capture(dir + "/out/captures/M1_700mm_r1_j1.csv");
+  std::string one;
+  for (double v : k.samples) one += sci(v) + "\n";
+  write(dir + "/one.csv", one);
+  const ToolRun ref = run_tool("decode " + dir + "/out/captures/M1_700mm_r1_j1.csv --family M1 --json");
+  const ToolRun got = run_tool("decode " + dir + "/one.csv --family M1 --json --sample-rate " + sci(k.sample_rate));
+  ASSERT_EQ(ref.status, 0) << ref.err;
+  ASSERT_EQ(got.status, 0) << got.err;
+  const auto jr = nlohmann::json::parse(ref.out), jg = nlohmann::json::parse(got.out);
+  EXPECT_EQ(jg["sample_rate_source"], "option --sample-rate");
+  EXPECT_EQ(jr["sample_rate_source"], "capture file");
+  ASSERT_EQ(jg["detections"].size(), 1u) << got.out;
+  ASSERT_EQ(jr["detections"].size(), 1u) << ref.out;
+  EXPECT_EQ(jg["detections"][0]["code"], 1);
+  // the simulated capture starts at t = 0 too, so the times agree exactly
+  EXPECT_EQ(jg["detections"][0]["tof_s"], jr["detections"][0]["tof_s"]);
 }

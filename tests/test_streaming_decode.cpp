@@ -228,27 +228,27 @@ TEST(StreamingDecode, EveryChannelStreamsAsReadCaptureReadsIt) {
     const int channels = name.ends_with(".wav") ? 2 : 3;
     for (int ch = 1; ch <= channels; ++ch) {
       SCOPED_TRACE(name + " channel " + std::to_string(ch));
-      const Capture whole = read_capture(p, ch);
-      CaptureSource src(p, ch);
+      const Capture whole = read_capture(p, {.channel = ch});
+      CaptureSource src(p, {.channel = ch});
       EXPECT_EQ(src.channels(), channels);
       EXPECT_EQ(whole.channels, channels);
       std::vector<double> all, block(97);
       for (std::size_t k; (k = src.read(block)) > 0;) all.insert(all.end(), block.begin(), block.begin() + static_cast<long>(k));
       EXPECT_EQ(all, whole.samples);
       if (ch == 2 && name.ends_with(".wav")) {
-        const Capture first = read_capture(p, 1);
+        const Capture first = read_capture(p, {.channel = 1});
         ASSERT_EQ(first.samples.size(), whole.samples.size());
         for (std::size_t n = 0; n < first.samples.size(); ++n) ASSERT_EQ(whole.samples[n], -2.0 * first.samples[n]);
       }
     }
     std::string a, b;
     try {
-      (void)read_capture(p, channels + 1);
+      (void)read_capture(p, {.channel = channels + 1});
     } catch (const InputError& e) {
       a = e.what();
     }
     try {
-      CaptureSource s(p, channels + 1);
+      CaptureSource s(p, {.channel = channels + 1});
     } catch (const InputError& e) {
       b = e.what();
     }

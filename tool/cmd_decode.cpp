@@ -103,6 +103,7 @@ int cmd_decode(const Args& args) {
   p.positional("CAPTURE", "capture file (.csv or .wav)");
   add_family_option(p, "the one the transmitter used; default: the capture's metadata");
   p.option("--channel", "N", "the channel to decode, 1..65535: a WAV's Nth channel, a CSV's column N + 1 (the first is the time); the --calibrate capture is read on the same channel", "1");
+  p.option("--sample-rate", "HZ", "the capture's sample rate, 1e4..1e9 Hz, for a CSV of one column of samples and no time (numpy.savetxt of an array; read from t = 0), or to replace a WAV header's rate; a CSV with a time column refuses it (the rate comes from the time)");
   p.option("--references", "DIR", "recorded reference bursts DIR/<family>-<j>.csv|.wav for the Pearson decoder");
   add_speed_of_sound_option(p, "the capture's metadata, else 340");
   p.option("--temperature", "C", "air temperature -40..60 C: speed of sound at 50 % RH, 101.325 kPa");
@@ -120,8 +121,19 @@ int cmd_decode(const Args& args) {
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
   const auto block = static_cast<std::size_t>(p.integer("--block-samples", 1 << 20, 64, 1 << 26));
   const int channel = static_cast<int>(p.integer("--channel", 1, 1, 65535));
+  const CaptureRead how{channel, p.has("--sample-rate") ? p.number("--sample-rate", 0, 1e4, 1e9) : 0.0};
   // Streamed (model/sim/capture_stream.hpp): validated whole at open, then read in blocks.
-  CaptureSource cap(path, channel);
+  CaptureSource cap(path, how);
+  std::string rate_note;  // where the sample rate came from, when an option set it
+  if (how.sample_rate > 0) {
+    std::ostringstream os;
+    os.precision(9);
+    os << "sample rate " << how.sample_rate << " Hz from option --sample-rate";
+    if (cap.file_rate() > 0 && std::abs(cap.file_rate() - how.sample_rate) > 1e-9 * how.sample_rate) {
+      os << " (the file's header says " << cap.file_rate() << " Hz)";
+    }
+    rate_note = os.str();
+  }
   const CaptureMeta& meta = cap.meta();
   const std::string meta_src = "capture metadata (" + (meta.source.empty() ? path : meta.source) + ")";
 
@@ -211,7 +223,7 @@ int cmd_decode(const Args& args) {
   std::optional<LatencyCalibration> cal;
   if (p.has("--calibrate")) {
     const std::string cal_path = *p.get("--calibrate");
-    Capture k = read_capture(cal_path, channel);
+    Capture k = read_capture(cal_path, how);
     if (std::abs(check_rate(k.sample_rate, cal_path) - fs) > 1e-6 * fs) {
       throw InputError("option --calibrate: " + cal_path + " is sampled at " + std::to_string(k.sample_rate) +
                        " Hz, the capture at " + std::to_string(cap.sample_rate()) + " Hz");
@@ -244,7 +256,7 @@ int cmd_decode(const Args& args) {
     (d.rho_max >= min_rho ? dets : below).push_back(d);
   }
   if (p.has("--plot")) {  // the picture needs the whole capture in memory (decoding does not)
-    plot_decode(*p.get("--plot"), scene, family, read_capture(path, channel), fs, dets, below);
+    plot_decode(*p.get("--plot"), scene, family, read_capture(path, how), fs, dets, below);
   }
   const bool known = meta.code_sent && *meta.code_sent > 0;
   auto det_json = [&](const Detection& d) {
@@ -263,6 +275,7 @@ int cmd_decode(const Args& args) {
     j["sample_rate"] = cap.sample_rate();
     j["channel"] = channel;
     j["channels"] = cap.channels();
+    j["sample_rate_source"] = rate_note.empty() ? std::string("capture file") : std::string("option --sample-rate");
     j["family"] = family;
     j["family_source"] = family_source;
     j["speed_of_sound"] = c.value;
@@ -288,9 +301,9 @@ int cmd_decode(const Args& args) {
                            {"rule", "runs of >= 3 consecutive samples at the capture's maximum or minimum"}};
     std::cout << stamp_build_info(j).dump(2) << "\n";
   } else {
-    std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s\n",
+    std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s%s%s\n",
                  family.c_str(), family_source.c_str(), c.value, c.source.c_str(), period.value,
-                 period.source.c_str());
+                 period.source.c_str(), rate_note.empty() ? "" : "; ", rate_note.c_str());
     const std::string chan = cap.channels() > 1 ? ", channel " + std::to_string(channel) + " of " +
                                                       std::to_string(cap.channels())
                                                 : std::string();

@@ -25,10 +25,10 @@ char csv_separator(const std::string& line) {
   return '\0';
 }
 
-double csv_row_value(const std::string& line, int channel) {
+double csv_row_value(const std::string& line, int cell) {
   const char sep = csv_separator(line);
   const char* p = line.c_str();
-  for (int c = 0; c < channel; ++c) {  // past `channel` cells (the time and the channels before)
+  for (int c = 0; c < cell; ++c) {  // past the cells before it
     if (sep != '\0') {
       while (*p != '\0' && *p != sep) ++p;
       if (*p == sep) ++p;
@@ -176,8 +176,12 @@ CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& 
   return m;
 }
 
-CsvCaptureScan::CsvCaptureScan(std::string origin, int channel) : origin_(std::move(origin)), channel_(channel) {
-  if (channel < 1) throw InputError(origin_ + ": channel " + std::to_string(channel) + " is out of range; valid >= 1");
+CsvCaptureScan::CsvCaptureScan(std::string origin, const CaptureRead& how)
+    : origin_(std::move(origin)), channel_(how.channel), given_rate_(how.sample_rate) {
+  if (channel_ < 1) throw InputError(origin_ + ": channel " + std::to_string(channel_) + " is out of range; valid >= 1");
+  if (!(given_rate_ >= 0 && given_rate_ <= 1e12)) {
+    throw InputError(origin_ + ": sample rate " + std::to_string(given_rate_) + " Hz is out of range; valid (0, 1e12]");
+  }
 }
 
 bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
@@ -199,11 +203,41 @@ bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
   }
   if (!data_) {
     first_data_line_ = lineno_;
-    channels_ = static_cast<int>(std::max<std::size_t>(cells.size(), 1) - 1);
+    no_time_ = cells.size() == 1 && given_rate_ > 0;  // samples alone, at the given rate
+    channels_ = no_time_ ? 1 : static_cast<int>(std::max<std::size_t>(cells.size(), 1) - 1);
+    if (!no_time_ && given_rate_ > 0) {
+      std::ostringstream os;
+      os.precision(9);
+      os << "a sample rate (" << given_rate_ << " Hz) was given, but the rows have a time column, which sets the "
+         << "rate; give a rate only for a CSV of one column of samples, or a WAV";
+      fail_at(origin_, lineno_, os.str());
+    }
   }
   data_ = true;
+  if (no_time_) {
+    double x = 0;
+    if (cells.size() != 1) {
+      fail_at(origin_, lineno_, "expected one column of samples (as the first data row), found " +
+                                    std::to_string(cells.size()));
+    }
+    if (channel_ != 1) {
+      fail_at(origin_, lineno_, "channel " + std::to_string(channel_) + " is out of range: the rows have 1 channel; valid 1..1");
+    }
+    if (!parse_number(cells[0], x)) fail_at(origin_, lineno_, "sample: '" + cells[0] + "' is not a number");
+    if (!std::isfinite(x)) fail_at(origin_, lineno_, "sample: '" + cells[0] + "' is not finite (NaN or Inf)");
+    t = static_cast<double>(rows_) / given_rate_;
+    if (rows_ == 0) t_first_ = t;
+    t_last_ = t;
+    last_data_line_ = lineno_;
+    ++rows_;
+    v = x;
+    return true;
+  }
   const auto ch = static_cast<std::size_t>(channel_);
-  if (cells.size() < 2) fail_at(origin_, lineno_, "expected 'time,voltage', found one column");
+  if (cells.size() < 2) {
+    fail_at(origin_, lineno_, "expected 'time,voltage', found one column (a CSV of samples alone is read with its "
+                              "sample rate given: decode --sample-rate HZ)");
+  }
   if (cells.size() < ch + 1) {
     fail_at(origin_, lineno_, "channel " + std::to_string(channel_) + " (column " + std::to_string(channel_ + 1) +
                                   ") is out of range: the row has " + std::to_string(cells.size() - 1) +
@@ -240,6 +274,11 @@ void CsvCaptureScan::finish() {
   }
   if (rows_ == 0) fail_at(origin_, lineno_, "no data rows (empty capture; expected rows 'time_s,volts')");
   if (rows_ < 2) fail_at(origin_, lineno_, "one data row: a capture needs at least two samples");
+  if (no_time_) {
+    dt_ = 1.0 / given_rate_;
+    if (!meta_.empty()) meta_.source = "csv header";
+    return;
+  }
   const double span = t_last_ - t_first_;
   dt_ = span / static_cast<double>(rows_ - 1);
   if (!std::isfinite(span) || !(dt_ > 0) || !(1.0 / dt_ >= 1.0 && 1.0 / dt_ <= 1e12)) {
@@ -262,8 +301,8 @@ void CsvCaptureScan::check_grid(std::size_t n, double t, std::size_t line) const
   }
 }
 
-Capture parse_capture_csv(const std::string& text, const std::string& origin, int channel) {
-  CsvCaptureScan scan(origin, channel);
+Capture parse_capture_csv(const std::string& text, const std::string& origin, const CaptureRead& how) {
+  CsvCaptureScan scan(origin, how);
   std::vector<double> t, v;
   std::vector<std::size_t> lines;
   std::stringstream in(text);
@@ -282,8 +321,9 @@ Capture parse_capture_csv(const std::string& text, const std::string& origin, in
   c.t0 = scan.t0();
   c.meta = scan.meta();
   c.samples = std::move(v);
-  c.channel = channel;
+  c.channel = how.channel;
   c.channels = scan.channels();
+  c.file_rate = scan.has_time() ? c.sample_rate : 0;
   return c;
 }
 
@@ -420,13 +460,14 @@ void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const st
   }
 }
 
-Capture parse_capture_wav(const std::string& b, const std::string& origin, int channel) {
+Capture parse_capture_wav(const std::string& b, const std::string& origin, const CaptureRead& how) {
   const WavLayout w = parse_wav_layout([&](std::size_t at, std::size_t len) { return b.substr(at, len); }, b.size(),
-                                       origin, channel);
+                                       origin, how.channel);
   Capture c;
-  c.channel = channel;
+  c.channel = how.channel;
   c.channels = static_cast<int>(w.channels);
-  c.sample_rate = w.rate;
+  c.file_rate = w.rate;
+  c.sample_rate = how.sample_rate > 0 ? how.sample_rate : w.rate;
   c.samples.resize(w.n);
   wav_samples(b.data() + w.body, w.n, w, origin, 0, c.samples.data());
   if (w.n < 2) fail_wav(origin, w.chunk_at, "the data chunk holds fewer than two samples");
@@ -452,7 +493,7 @@ void merge_capture_sidecar(CaptureMeta& o, const std::string& path) {
   }
 }
 
-Capture read_capture(const std::string& path, int channel) {
+Capture read_capture(const std::string& path, const CaptureRead& how) {
   std::string ext;
   if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
@@ -460,7 +501,7 @@ Capture read_capture(const std::string& path, int channel) {
     throw InputError(path + ": unknown capture type '." + ext + "'; valid: .csv (oscilloscope export), .wav");
   }
   const std::string bytes = read_input_file(path, "capture file", std::size_t{1} << 30);
-  Capture c = ext == "csv" ? parse_capture_csv(bytes, path, channel) : parse_capture_wav(bytes, path, channel);
+  Capture c = ext == "csv" ? parse_capture_csv(bytes, path, how) : parse_capture_wav(bytes, path, how);
   merge_capture_sidecar(c.meta, path);
   return c;
 }

@@ -15,6 +15,10 @@
 // as full-scale fractions (code / 2^(bits-1), 8-bit as (code - 128) / 128).
 // Channels: the readers take a 1-based channel (default 1) and report how many the file has
 // (CSV: the value columns of the first data row; every data row must hold the channel read).
+// A given sample rate (CaptureRead::sample_rate > 0): a CSV whose rows are one column of samples
+// and no time (numpy.savetxt of an array) is read at that rate from t = 0 (without one it is
+// refused); a CSV with a time column refuses it (its rate comes from the time); a WAV's header
+// rate is replaced by it (a simulator that wrote a placeholder rate).
 // Every error is an InputError naming the file and line (CSV) or byte offset (WAV).
 //
 // Metadata (what `simulate --write-captures` knows about the stream), all optional:
@@ -52,6 +56,14 @@ struct Capture {
   CaptureMeta meta;
   int channel = 1;               // the channel read (1-based)
   int channels = 1;              // how many the file has
+  double file_rate = 0;          // the rate the file states (WAV header, CSV time column; 0: none)
+};
+
+// How to read a capture: the channel (1-based) and, when the file does not hold the rate or
+// holds a wrong one, the sample rate (Hz; 0: the file's).
+struct CaptureRead {
+  int channel = 1;
+  double sample_rate = 0;
 };
 
 // The sidecar JSON's text for meta, and its parse (InputError naming origin and the key).
@@ -61,9 +73,9 @@ CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& 
 // By extension: .csv or .wav (case-insensitive); anything else is refused. channel: 1-based;
 // one the file does not have is an InputError naming the file, the line (CSV) or byte (WAV),
 // and the valid range.
-Capture read_capture(const std::string& path, int channel = 1);
-Capture parse_capture_csv(const std::string& text, const std::string& origin, int channel = 1);
-Capture parse_capture_wav(const std::string& bytes, const std::string& origin, int channel = 1);
+Capture read_capture(const std::string& path, const CaptureRead& how = {});
+Capture parse_capture_csv(const std::string& text, const std::string& origin, const CaptureRead& how = {});
+Capture parse_capture_wav(const std::string& bytes, const std::string& origin, const CaptureRead& how = {});
 
 enum class WavFormat { Pcm8, Pcm16, Pcm24, Pcm32, Float32, Float64 };
 

@@ -15,7 +15,7 @@ namespace {
 constexpr std::size_t kWavBlockBytes = std::size_t{1} << 20;
 }
 
-CaptureSource::CaptureSource(const std::string& path, int channel) : path_(path), channel_(channel) {
+CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how) : path_(path), channel_(how.channel) {
   std::string ext;
   if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
@@ -33,7 +33,7 @@ CaptureSource::CaptureSource(const std::string& path, int channel) : path_(path)
   if (!in_) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
   const std::size_t file_size = static_cast<std::size_t>(fs::file_size(path, ec));
   if (csv_) {
-    CsvCaptureScan scan(path, channel);
+    CsvCaptureScan scan(path, how);
     std::string line;
     double t = 0, v = 0;
     while (std::getline(in_, line)) (void)scan.line(line, t, v);
@@ -42,7 +42,7 @@ CaptureSource::CaptureSource(const std::string& path, int channel) : path_(path)
     // Second pass: every row on the uniform grid (the rows are known to be well formed now).
     in_.clear();
     in_.seekg(0);
-    CsvCaptureScan again(path, channel);
+    CsvCaptureScan again(path, how);
     std::size_t n = 0;
     while (std::getline(in_, line)) {
       if (again.line(line, t, v)) scan.check_grid(n++, t, again.lineno());
@@ -53,6 +53,8 @@ CaptureSource::CaptureSource(const std::string& path, int channel) : path_(path)
     meta_ = scan.meta();
     first_data_line_ = scan.first_data_line();
     channels_ = scan.channels();
+    cell_ = scan.value_cell();
+    file_rate_ = scan.has_time() ? rate_ : 0;
   } else {
     wav_ = parse_wav_layout(
         [&](std::size_t at, std::size_t len) {
@@ -63,9 +65,10 @@ CaptureSource::CaptureSource(const std::string& path, int channel) : path_(path)
           b.resize(static_cast<std::size_t>(std::max<std::streamsize>(in_.gcount(), 0)));
           return b;
         },
-        file_size, path, channel);
+        file_size, path, how.channel);
     channels_ = static_cast<int>(wav_.channels);
-    rate_ = wav_.rate;
+    file_rate_ = wav_.rate;
+    rate_ = how.sample_rate > 0 ? how.sample_rate : wav_.rate;
     n_ = wav_.n;
     if (wav_.flt || n_ < 2) {  // NaN/Inf are refused before anything is decoded (read_capture's order)
       rewind();
@@ -100,7 +103,7 @@ std::size_t CaptureSource::read(std::span<double> out) {
       ++lineno_;
       if (lineno_ < first_data_line_) continue;
       // The rows were validated at open: the channel's cell is a finite number.
-      out[k++] = csv_row_value(line, channel_);
+      out[k++] = csv_row_value(line, cell_);
       ++pos_;
     }
     if (k < out.size() && pos_ < n_) throw InputError(path_ + ": changed while it was read (fewer rows than at open)");

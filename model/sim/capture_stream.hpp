@@ -26,15 +26,16 @@
 namespace ranging {
 
 // A CSV line's separator: ';' if it has one, else ',' if it has one, else '\0' (runs of tabs
-// and spaces). csv_row_value: cell `channel` (0 is the time) of a data row that CsvCaptureScan
-// validated.
+// and spaces). csv_row_value: cell `cell` (0-based: 1 is the first channel after the time) of a
+// data row that CsvCaptureScan validated.
 char csv_separator(const std::string& line);
-double csv_row_value(const std::string& line, int channel = 1);
+double csv_row_value(const std::string& line, int cell = 1);
 
 class CsvCaptureScan {
  public:
-  // channel: the 1-based value column read (column channel + 1 of each row)
-  explicit CsvCaptureScan(std::string origin, int channel = 1);
+  // how.channel: the 1-based value column read (column channel + 1 of each row); how.sample_rate:
+  // rows of one column are samples at that rate (capture.hpp)
+  explicit CsvCaptureScan(std::string origin, const CaptureRead& how = {});
   // One line of the file (without its newline): true for a data row (t, v set).
   bool line(const std::string& text, double& t, double& v);
   void finish();  // after the last line: the file-level checks; sample_rate() and t0() valid after it
@@ -46,10 +47,14 @@ class CsvCaptureScan {
   double t0() const { return t_first_; }
   const CaptureMeta& meta() const { return meta_; }
   int channels() const { return channels_; }  // value columns of the first data row
+  bool has_time() const { return !no_time_; }  // false: rows of samples alone (a given rate)
+  int value_cell() const { return no_time_ ? channel_ - 1 : channel_; }  // the cell read, 0-based
 
  private:
   std::string origin_;
   int channel_ = 1, channels_ = 0;
+  double given_rate_ = 0;
+  bool no_time_ = false;
   CaptureMeta meta_;
   std::size_t lineno_ = 0, rows_ = 0, first_data_line_ = 0, last_data_line_ = 0, record_line_ = 0;
   bool data_ = false;
@@ -82,11 +87,12 @@ void merge_capture_sidecar(CaptureMeta& meta, const std::string& path);
 
 class CaptureSource {
  public:
-  // Validates the whole file (InputError); channel: 1-based, as read_capture.
-  explicit CaptureSource(const std::string& path, int channel = 1);
+  // Validates the whole file (InputError); how: as read_capture.
+  explicit CaptureSource(const std::string& path, const CaptureRead& how = {});
   ~CaptureSource();
   int channels() const { return channels_; }  // how many the file has
   int channel() const { return channel_; }
+  double file_rate() const { return file_rate_; }  // the rate the file states (0: none)
   double sample_rate() const { return rate_; }
   double t0() const { return t0_; }
   std::size_t size() const { return n_; }
@@ -99,8 +105,8 @@ class CaptureSource {
  private:
   std::string path_;
   bool csv_ = false;
-  int channel_ = 1, channels_ = 1;
-  double rate_ = 0, t0_ = 0;
+  int channel_ = 1, channels_ = 1, cell_ = 1;
+  double rate_ = 0, t0_ = 0, file_rate_ = 0;
   std::size_t n_ = 0, pos_ = 0;
   CaptureMeta meta_;
   WavLayout wav_;
