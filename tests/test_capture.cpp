@@ -575,3 +575,22 @@ TEST(DecodeCli, ACsvOfSamplesAloneDecodesWithItsSampleRateGiven) {
   // the simulated capture starts at t = 0 too, so the times agree exactly
   EXPECT_EQ(jg["detections"][0]["tof_s"], jr["detections"][0]["tof_s"]);
 }
+
+// A capture at 1 MS/s (5 samples per 200 kHz cycle): the receiver cannot decode a noise-free
+// burst there, so decode refuses (exit 2, nothing on stdout) naming the rate and what to change.
+TEST(DecodeCli, ARateTooLowForTheReceiverIsRefusedNamingTheRate) {
+  const std::string dir = ::testing::TempDir() + "/capture_1ms_" + std::to_string(::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  Capture c;
+  c.sample_rate = 1e6;
+  for (int n = 0; n < 20000; ++n) c.samples.push_back(0.01 * std::sin(0.37 * n * n));
+  write(dir + "/slow.wav", capture_wav(c, WavFormat::Pcm16));
+  const ToolRun r = run_tool("decode " + dir + "/slow.wav --family Gold4");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_NE(r.err.find("slow.wav: calibration:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(1 MS/s, 5 samples per carrier cycle); lower receiver.threshold, raise the sample rate"),
+            std::string::npos)
+      << r.err;
+}

@@ -377,8 +377,9 @@ struct SceneSimulator::Link {
         },
         [&](int code) {
           return s.origin + ": calibration: code " + std::to_string(code) + " of " + family_name +
-                 " was not decoded on a noise-free burst at " + fmt(d) +
-                 " m; lower receiver.threshold or check the scene's stages";
+                 " was not decoded on a noise-free burst at " + fmt(d) + " m (" + fmt(s.fs / 1e6) + " MS/s, " +
+                 fmt(s.fs / s.excitation.carrier_hz) + " samples per carrier cycle); lower receiver.threshold, " +
+                 "raise the sample rate (few samples per cycle blur the chips) or check the scene's stages";
         });
     templates.assign(eta, {});
     for (std::size_t j = 0; j < eta; ++j) {
