@@ -11,6 +11,12 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <thread>
+#include <vector>
+
+#include "model/config/overrides.hpp"
+#include "model/sim/scene.hpp"
+#include "model/study/sweep.hpp"
 
 #include "tests/process.hpp"
 
@@ -267,4 +273,69 @@ TEST_F(Sweep, GnuParallelShardsMergeToTheSerialRun) {
                           (dir_ / "p1").string() + " " + (dir_ / "p2").string());
   ASSERT_EQ(m.status, 0) << m.err;
   EXPECT_EQ(result(dir_ / "merged"), ref);
+}
+
+// The float-reference cache (model/study/sweep.hpp): points that differ only in what the float
+// model does not read (word lengths, detector.frac_bits, the clock, system keys) share one float
+// run; a key the float model reads is a different entry. The points' results are the same with
+// and without the cache, on one thread and on two.
+TEST_F(Sweep, FloatReferenceCacheSharesOnlyWhatTheFloatModelIgnores) {
+  namespace st = ranging::study;
+  const std::string cfg = kSource + "/configs/default.yaml";
+  auto scene_with = [&](const ranging::Overrides& ov) {
+    ranging::Overrides all;
+    for (const auto& [k, v] : ov) all.push_back({k.rfind("scene.", 0) == 0 ? k.substr(6) : "receiver.config." + k, v});
+    std::ofstream(dir_ / "s2.yaml") << slurp(dir_ / "scene.yaml") << "receiver:\n  config: " << cfg << "\n";
+    return ranging::load_scene((dir_ / "s2.yaml").string(), all);
+  };
+  const std::string base = st::float_reference_key(scene_with({}));
+  for (const auto& [k, v] : std::vector<std::pair<std::string, std::string>>{
+           {"bandpass_fixed.coef_bits", "18"}, {"correlator_fixed.chip_bits", "18"}, {"detector.frac_bits", "6"},
+           {"hardware.clock_hz", "60000000"}, {"system.time_w", "32"}, {"name", "other"}}) {
+    EXPECT_EQ(st::float_reference_key(scene_with({{k, v}})), base) << k << " is ignored by the float model";
+  }
+  for (const auto& [k, v] : std::vector<std::pair<std::string, std::string>>{
+           {"detector.threshold", "0.45"}, {"correlator.decimation", "10"}, {"correlator.template_floor", "0.2"},
+           {"filter.type", "cheby1"}, {"scene.noise.seed", "5"}, {"scene.geometry.distances_m", "[0.3, 0.9]"}}) {
+    EXPECT_NE(st::float_reference_key(scene_with({{k, v}})), base) << k << " is read by the float model";
+  }
+
+  const fs::path s = spec("cache", "  - key: correlator_fixed.chip_bits\n    values: [16, 22]\n"
+                                   "  - key: detector.threshold\n    values: [0.5, 0.45]\n");
+  const st::SweepSpec sp = st::load_sweep_spec(s.string());
+  const auto points = st::sweep_points(sp);
+  ASSERT_EQ(points.size(), 5u);  // the base and the 2 x 2 grid
+  auto strip = [](json j) {
+    j.erase("speed");
+    return j;
+  };
+  st::PointOptions plain;
+  plain.synth = false;
+  std::vector<json> want;
+  for (const auto& p : points) want.push_back(strip(st::evaluate_point(sp, p, plain)));
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    st::PointOptions cached = plain;
+    cached.float_cache = std::make_shared<st::FloatReferenceCache>();
+    std::vector<json> got(points.size());
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) {
+      pool.emplace_back([&, t] {
+        for (std::size_t i = static_cast<std::size_t>(t); i < points.size(); i += static_cast<std::size_t>(threads)) {
+          got[i] = st::evaluate_point(sp, points[i], cached);
+        }
+      });
+    }
+    for (auto& th : pool) th.join();
+    std::size_t shared = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      ASSERT_EQ(got[i]["status"], "ok") << got[i].dump();
+      shared += got[i]["speed"]["float_reference"] == "shared";
+      EXPECT_EQ(strip(got[i]), want[i]) << points[i].id;
+    }
+    // two thresholds (0.5 is the base's): two float runs, three points share them
+    EXPECT_EQ(cached.float_cache->misses(), 2u);
+    EXPECT_EQ(cached.float_cache->hits(), 3u);
+    EXPECT_EQ(shared, 3u);
+  }
 }

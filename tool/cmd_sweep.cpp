@@ -230,6 +230,7 @@ int cmd_sweep(const Args& args) {
 
   study::PointOptions opt;
   opt.synth = !p.has("--no-synth");
+  opt.float_cache = std::make_shared<study::FloatReferenceCache>();  // word-length points share a float run
   opt.targets = targets;
   opt.cache_dir = fs::absolute(cache).string();
   opt.source_dir = source_dir();

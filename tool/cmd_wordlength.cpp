@@ -29,6 +29,7 @@ int cmd_wordlength(const Args& args) {
   namespace fs = std::filesystem;
   study::PointOptions opt;
   opt.synth = false;
+  opt.float_cache = std::make_shared<study::FloatReferenceCache>();  // every candidate shares the base's float run
   const bool quiet = p.has("--quiet");
   nlohmann::json r = study::optimize_wordlengths(spec, opt, [&](const std::string& what) {
     if (!quiet) std::fprintf(stderr, "evaluated %s\n", what.c_str());

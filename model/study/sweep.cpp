@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <future>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -379,6 +381,65 @@ long long word_bits(const ReceiverConfig& c) {
 
 }  // namespace
 
+struct FloatReferenceCache::Impl {
+  using Rows = std::shared_ptr<const std::vector<Measurement>>;
+  std::mutex mutex;
+  std::map<std::string, std::shared_future<Rows>> rows;
+  std::size_t hits = 0, misses = 0;
+  // The rows of key: computed by make in the first caller's thread (its exception too, which
+  // every caller of the key gets), waited for by the others; shared: whether they were already there.
+  Rows get(const std::string& key, const std::function<std::vector<Measurement>()>& make, bool& shared) {
+    std::promise<Rows> mine;
+    std::shared_future<Rows> f;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      const auto it = rows.find(key);
+      shared = it != rows.end();
+      if (shared) {
+        ++hits;
+        f = it->second;
+      } else {
+        ++misses;
+        f = mine.get_future().share();
+        rows.emplace(key, f);
+      }
+    }
+    if (!shared) {
+      try {
+        mine.set_value(std::make_shared<const std::vector<Measurement>>(make()));
+      } catch (...) {
+        mine.set_exception(std::current_exception());
+      }
+    }
+    return f.get();
+  }
+};
+FloatReferenceCache::FloatReferenceCache() : impl(std::make_unique<Impl>()) {}
+FloatReferenceCache::~FloatReferenceCache() = default;
+std::size_t FloatReferenceCache::hits() const {
+  std::lock_guard<std::mutex> lock(impl->mutex);
+  return impl->hits;
+}
+std::size_t FloatReferenceCache::misses() const {
+  std::lock_guard<std::mutex> lock(impl->mutex);
+  return impl->misses;
+}
+
+std::string float_reference_key(const Scene& scene) {
+  Scene s = scene;
+  s.receiver.precision = "float";
+  ReceiverConfig& c = s.receiver.config;
+  const ReceiverConfig d;  // the defaults of the keys the float model does not read
+  c.name = d.name;
+  c.bandpass = d.bandpass;
+  c.correlator = d.correlator;
+  c.detector.frac_bits = d.detector.frac_bits;
+  c.clock_hz = d.clock_hz;
+  c.system = d.system;
+  c.allow_out_of_spec = d.allow_out_of_spec;
+  return effective_scene_yaml(s, "config.yaml") + "\n--- config.yaml\n" + receiver_config_yaml(c);
+}
+
 json evaluate_point(const SweepSpec& spec, const PointDef& point, const PointOptions& options) {
   json params = json::object();
   for (const auto& [k, v] : point.params) params[k] = v;
@@ -413,15 +474,23 @@ json evaluate_point(const SweepSpec& spec, const PointDef& point, const PointOpt
       rows.insert(rows.end(), r.begin(), r.end());
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    // Float reference.
-    Scene fscene = scene;
-    fscene.receiver.precision = "float";
-    SceneSimulator flt(fscene);
-    std::vector<Measurement> frows;
-    for (const auto& f : scene.excitation.families) {
-      auto r = flt.run(f);
-      frows.insert(frows.end(), r.begin(), r.end());
-    }
+    // Float reference (shared by the points that differ only in what the float model ignores).
+    auto run_float = [&] {
+      Scene fscene = scene;
+      fscene.receiver.precision = "float";
+      SceneSimulator flt(fscene);
+      std::vector<Measurement> r;
+      for (const auto& f : scene.excitation.families) {
+        auto fr = flt.run(f);
+        r.insert(r.end(), fr.begin(), fr.end());
+      }
+      return r;
+    };
+    bool float_cached = false;
+    const FloatReferenceCache::Impl::Rows float_rows =
+        options.float_cache ? options.float_cache->impl->get(float_reference_key(scene), run_float, float_cached)
+                            : std::make_shared<const std::vector<Measurement>>(run_float());
+    const std::vector<Measurement>& frows = *float_rows;
     std::size_t wrong = 0, missed = 0, correct = 0, disagree = 0;
     double se = 0, max_err = 0, tof_dev = 0;
     for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -474,7 +543,8 @@ json evaluate_point(const SweepSpec& spec, const PointDef& point, const PointOpt
                         {"max_quantized_pole_radius", jnum(guard.max_quantized_radius())},
                         {"failures", guard.failures}};
     out["speed"] = {{"fixed_samples_per_s", seconds > 0 ? static_cast<double>(samples) / seconds : 0.0},
-                    {"samples", samples}};
+                    {"samples", samples},
+                    {"float_reference", float_cached ? "shared" : "computed"}};
     out["status"] = "ok";
   } catch (const InputError& e) {
     out["status"] = "refused";

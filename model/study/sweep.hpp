@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +23,9 @@
 namespace ranging::yaml {
 class Reader;
 }  // namespace ranging::yaml
+namespace ranging {
+struct Scene;
+}  // namespace ranging
 
 namespace ranging::study {
 
@@ -65,8 +69,27 @@ std::vector<PointDef> sweep_points(const SweepSpec& spec);
 // Whether the point belongs to shard i of n (by its id's hash).
 bool in_shard(const PointDef& p, int i, int n);
 
+// The float model's rows of a sweep's points (the ToF reference every point is compared with),
+// keyed by everything the float model reads: the effective scene and the receiver configuration
+// less its fixed-point word lengths, detector.frac_bits, hardware.clock_hz, system keys and name
+// (float_reference_key). Points that differ only in those (a word-length sweep, `ranging
+// wordlength`) share one float run. Thread-safe: a key is computed once even when points run in
+// parallel, the others wait for it. Results are identical with and without it.
+class FloatReferenceCache {
+ public:
+  FloatReferenceCache();
+  ~FloatReferenceCache();
+  FloatReferenceCache(const FloatReferenceCache&) = delete;
+  FloatReferenceCache& operator=(const FloatReferenceCache&) = delete;
+  std::size_t hits() const;
+  std::size_t misses() const;
+  struct Impl;
+  std::unique_ptr<Impl> impl;
+};
+
 struct PointOptions {
   bool synth = true;
+  std::shared_ptr<FloatReferenceCache> float_cache;  // null: the float model runs for every point
   // Synthesis targets (synth_target_names()): ice40 (synth_ice40 -dsp: LUT4, DFF, carry,
   // SB_MAC16, EBR), ecp5 (synth_ecp5: LUT4, FF, CCU2C, MULT18, EBR), xilinx (synth_xilinx
   // -family xc7: LUT, FF, CARRY4, DSP48E1, RAMB18/36). The fronts use ice40's LUT4 when present.
@@ -76,6 +99,9 @@ struct PointOptions {
 };
 
 std::vector<std::string> synth_target_names();
+
+// The float-reference cache's key of a scene (see FloatReferenceCache).
+std::string float_reference_key(const ranging::Scene& scene);
 
 // {"id", "params", "default", "status": "ok" | "refused", "error", "accuracy", "cost", "speed"}.
 // A configuration the model refuses is "refused" with its error, not an exception.
