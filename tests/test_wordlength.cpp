@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 #include "model/config/receiver_config.hpp"
 #include "model/study/sweep.hpp"
@@ -55,4 +56,47 @@ TEST(WordLength, TheMinimumPassesOneBitLessFailsAndTheConfigurationCarriesIt) {
   EXPECT_NE(bad.err.find((dir / "bad.yaml").string() + ":4: nodes"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad"));
   fs::remove_all(dir);
+}
+
+// --jobs N searches the nodes on N threads: the result is the one thread's (only the points'
+// measured speed differs), and the evaluations are counted once each.
+TEST(WordLength, SeveralThreadsGiveTheSameResult) {
+  const fs::path dir = fs::temp_directory_path() / ("ranging_wordlength_jobs_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "scene.yaml") << "transducers: {}\ngeometry:\n  distances_m: [0.3, 0.8]\nexcitation:\n"
+                                       "  family: Gold4\n  codes: [2, 7]\nnoise:\n  noise_v: 0.01\n  seed: 3\n";
+  std::ofstream(dir / "spec.yaml") << "name: wl\nconfig: " << RANGING_SOURCE_DIR << "/configs/default.yaml\n"
+                                   << "scene: scene.yaml\ntolerance: {rmse_factor: 1.5, decode_errors: 0}\n"
+                                      "nodes: [correlator_fixed.chip_bits, correlator_fixed.tap_bits, "
+                                      "correlator_fixed.weight_bits]\n";
+  auto strip = [](json j) {
+    std::function<void(json&)> drop = [&](json& o) {
+      if (o.is_object()) {
+        o.erase("speed");
+        for (auto& [k, v] : o.items()) drop(v);
+      } else if (o.is_array()) {
+        for (auto& v : o) drop(v);
+      }
+    };
+    drop(j);
+    return j;
+  };
+  json first;
+  for (int jobs : {1, 3}) {
+    SCOPED_TRACE(jobs);
+    const std::string out = (dir / ("out" + std::to_string(jobs))).string();
+    const auto r = run_tool("wordlength " + (dir / "spec.yaml").string() + " --out " + out + " --quiet --jobs " +
+                            std::to_string(jobs));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const json doc = strip(json::parse(std::ifstream(out + "/wordlength.json")));
+    int per_node = 0;
+    for (const auto& n : doc["nodes"]) per_node += n["evaluations"].get<int>();
+    EXPECT_EQ(doc["evaluations"].get<int>(), 1 + per_node + 1 + doc["widenings"].get<int>());
+    if (first.is_null()) {
+      first = doc;
+    } else {
+      EXPECT_EQ(doc, first);
+    }
+  }
 }

@@ -23,6 +23,7 @@ int cmd_wordlength(const Args& args) {
   p.positional("SPEC", "spec (YAML): name, config, scene, tolerance {rmse_factor, decode_errors}, nodes [keys]");
   add_output_options(p, {.out = true, .quiet = true});
   p.flag("--synth", "also synthesize the base and the result (yosys synth_ice40; DIR/cache)");
+  add_jobs_option(p, "nodes searched");
   if (!p.parse(args)) return 0;
   const std::string out = p.required("--out");
   const study::WordLengthSpec spec = study::load_wordlength_spec(p.positionals().at(0));
@@ -31,9 +32,11 @@ int cmd_wordlength(const Args& args) {
   opt.synth = false;
   opt.float_cache = std::make_shared<study::FloatReferenceCache>();  // every candidate shares the base's float run
   const bool quiet = p.has("--quiet");
-  nlohmann::json r = study::optimize_wordlengths(spec, opt, [&](const std::string& what) {
-    if (!quiet) std::fprintf(stderr, "evaluated %s\n", what.c_str());
-  });
+  nlohmann::json r = study::optimize_wordlengths(
+      spec, opt, [&](const std::string& what) {
+        if (!quiet) std::fprintf(stderr, "evaluated %s\n", what.c_str());
+      },
+      jobs_option(p));
   Overrides ov;
   for (const auto& [k, v] : r["joint_params"].items()) ov.push_back({k, std::to_string(v.get<int>())});
   const ReceiverConfig result = load_receiver_config(spec.base.config_path, ov);

@@ -1,14 +1,17 @@
 #include "model/study/wordlength.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 #include <filesystem>
 #include <limits>
+#include <mutex>
 #include <set>
 
 #include "model/base/error.hpp"
+#include "model/base/parallel.hpp"
 #include "model/config/receiver_config.hpp"
 #include "model/config/yaml_reader.hpp"
 
@@ -82,15 +85,17 @@ std::string partner(const std::string& key) {
 }  // namespace
 
 json optimize_wordlengths(const WordLengthSpec& spec, const PointOptions& options,
-                          const std::function<void(const std::string&)>& progress) {
+                          const std::function<void(const std::string&)>& progress, int jobs) {
   const std::string cfg_yaml = receiver_config_yaml(load_receiver_config(spec.base.config_path));
-  int evaluations = 0;
+  std::atomic<int> evaluations{0};
+  std::mutex progress_mutex;
   auto eval = [&](const Params& p) {
     json r = evaluate_point(spec.base, {point_id(p), p}, options);
     ++evaluations;
     if (progress) {
       std::string s;
       for (const auto& [k, v] : p) s += (s.empty() ? "" : " ") + k + "=" + v;
+      std::lock_guard<std::mutex> lock(progress_mutex);
       progress(s.empty() ? "(base)" : s);
     }
     return r;
@@ -113,9 +118,12 @@ json optimize_wordlengths(const WordLengthSpec& spec, const PointOptions& option
     }
     return p;
   };
-  json nodes = json::array();
-  std::vector<int> minimum;
-  for (const auto& key : spec.nodes) {
+  // Each node alone: the narrowest width that passes, stepping down from the base (the nodes
+  // on `jobs` threads, each writing its own slot).
+  const std::size_t count = spec.nodes.size();
+  std::vector<int> minimum(count), base_bits(count), steps(count);
+  parallel_items(count, static_cast<std::size_t>(std::max(jobs, 1)), [&](std::size_t i, std::size_t) {
+    const std::string& key = spec.nodes[i];
     const int b = base_value(cfg_yaml, key);
     int best = b, n = 0;
     for (int v = b - 1; v >= 1; --v) {
@@ -123,8 +131,13 @@ json optimize_wordlengths(const WordLengthSpec& spec, const PointOptions& option
       if (!passes(eval(params_of(key, v)))) break;
       best = v;
     }
-    minimum.push_back(best);
-    nodes.push_back({{"key", key}, {"base", b}, {"min", best}, {"evaluations", n}});
+    minimum[i] = best;
+    base_bits[i] = b;
+    steps[i] = n;
+  });
+  json nodes = json::array();
+  for (std::size_t i = 0; i < count; ++i) {
+    nodes.push_back({{"key", spec.nodes[i]}, {"base", base_bits[i]}, {"min", minimum[i]}, {"evaluations", steps[i]}});
   }
   // Jointly: widen nodes in turn until the combination passes (at worst, back to the base).
   auto joint_params = [&] {
@@ -154,7 +167,7 @@ json optimize_wordlengths(const WordLengthSpec& spec, const PointOptions& option
   return json{{"tolerance", {{"rmse_factor", spec.rmse_factor}, {"decode_errors", spec.decode_errors},
                              {"rmse_limit_m", rmse_limit}}},
               {"base", base}, {"nodes", nodes}, {"joint", joint}, {"joint_params", jp},
-              {"joint_passes", passes(joint)}, {"widenings", widenings}, {"evaluations", evaluations}};
+              {"joint_passes", passes(joint)}, {"widenings", widenings}, {"evaluations", evaluations.load()}};
 }
 
 }  // namespace ranging::study

@@ -29,8 +29,11 @@ WordLengthSpec load_wordlength_spec(const std::string& path);
 std::vector<std::string> default_wordlength_nodes();
 
 // {"tolerance", "base": point, "nodes": [{"key", "base", "min", "evaluations"}], "joint": point,
-//  "joint_params": {...}, "evaluations": n}; tick(n) after every evaluation.
+//  "joint_params": {...}, "evaluations": n}; progress(what) after every evaluation (called from
+// one thread at a time). The nodes' searches (each against the base) run on `jobs` threads; the
+// result does not depend on jobs (only the points' "speed" does).
 nlohmann::json optimize_wordlengths(const WordLengthSpec& spec, const PointOptions& options,
-                                    const std::function<void(const std::string&)>& progress = {});
+                                    const std::function<void(const std::string&)>& progress = {},
+                                    int jobs = 1);
 
 }  // namespace ranging::study
