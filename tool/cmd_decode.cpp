@@ -238,20 +238,22 @@ int cmd_decode(const Args& args) {
     cal = calibrate_latency(kd, cal_distance, c.value, "option --calibrate (" + cal_path + ")");
   }
 
-  // Input clipping: the capture's flat tops at its extreme values (model/sim/metrics.hpp).
-  // Two streamed passes: the extremes, then the runs at them.
-  FlatTops clip;
+  // Input clipping: the capture's flat tops at its extreme values (model/sim/metrics.hpp), in
+  // two streamed passes: the extremes (whose larger magnitude is the decode's peak, so the
+  // decode skips its own peak pass), then the runs at them, during the receiver's pass.
+  FlatTopScan scan;
   {
-    FlatTopScan scan;
     std::vector<double> buf(std::min<std::size_t>(block, std::max<std::size_t>(cap.size(), 1)));
     cap.rewind();
     for (std::size_t k; (k = cap.read(buf)) > 0;) scan.levels(std::span<const double>(buf.data(), k));
-    cap.rewind();
-    for (std::size_t k; (k = cap.read(buf)) > 0;) scan.runs(std::span<const double>(buf.data(), k));
-    clip = scan.result();
   }
+  const FlatTops levels = scan.result();
+  const double peak = std::max(std::abs(levels.high), std::abs(levels.low));
   std::vector<Detection> dets, below;
-  for (auto d : sim.decode_stream(family, cap, period.value, block)) {
+  const auto decoded =
+      sim.decode_stream(family, cap, period.value, block, peak, [&](std::span<const double> x) { scan.runs(x); });
+  const FlatTops clip = scan.result();
+  for (auto d : decoded) {
     if (cal) d.tof_s = cal->correct(d.code, d.tof_s);
     (d.rho_max >= min_rho ? dets : below).push_back(d);
   }

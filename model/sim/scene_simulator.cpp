@@ -326,7 +326,8 @@ struct SceneSimulator::Link {
   }
 
   // receive() over a capture read in blocks, events only (the filtered stream is not kept).
-  std::vector<Event> receive_events(CaptureSource& src, double scale, std::size_t block) {
+  std::vector<Event> receive_events(CaptureSource& src, double scale, std::size_t block,
+                                    const std::function<void(std::span<const double>)>& on_block) {
     std::vector<Event> ev;
     const double inv = 1.0 / scale;
     std::vector<double> x(block);
@@ -334,6 +335,7 @@ struct SceneSimulator::Link {
     if (!fixed()) {
       ReceiverFloat rf(design);
       for (std::size_t k; (k = src.read(x)) > 0;) {
+        if (on_block) on_block(std::span<const double>(x.data(), k));
         for (std::size_t i = 0; i < k; ++i) x[i] *= inv;
         rf.execute_block(std::span<const double>(x.data(), k), ev);
       }
@@ -344,6 +346,7 @@ struct SceneSimulator::Link {
       std::vector<std::int64_t> raw(block);
       std::vector<EventFixed> raw_events;
       for (std::size_t k; (k = src.read(x)) > 0;) {
+        if (on_block) on_block(std::span<const double>(x.data(), k));
         for (std::size_t i = 0; i < k; ++i) {
           raw[i] = quantize_input(std::clamp(x[i] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
         }
@@ -916,24 +919,35 @@ std::vector<Detection> SceneSimulator::decode(const std::string& family, const s
 }
 
 std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, CaptureSource& src, double period_s,
-                                                     std::size_t block) {
+                                                     std::size_t block, std::optional<double> known_peak,
+                                                     const std::function<void(std::span<const double>)>& on_block) {
   Link& lk = link(family);
   block = std::max<std::size_t>(block, 1);
   std::vector<double> x(block);
   // Pass 1: the peak (the receiver sees the capture at half full scale at its peak).
   double peak = 0;
-  src.rewind();
-  for (std::size_t k; (k = src.read(x)) > 0;) {
-    for (std::size_t i = 0; i < k; ++i) peak = std::max(peak, std::abs(x[i]));
+  if (known_peak) {
+    peak = *known_peak;
+  } else {
+    src.rewind();
+    for (std::size_t k; (k = src.read(x)) > 0;) {
+      for (std::size_t i = 0; i < k; ++i) peak = std::max(peak, std::abs(x[i]));
+    }
   }
-  if (peak == 0) return {};
+  if (peak == 0) {  // nothing to receive; the caller's scan still sees every block
+    if (on_block) {
+      src.rewind();
+      for (std::size_t k; (k = src.read(x)) > 0;) on_block(std::span<const double>(x.data(), k));
+    }
+    return {};
+  }
   const double t0 = src.t0();
   const long n = static_cast<long>(src.size());
   const std::vector<Burst> schedule =
       decode_schedule(lk.design.family.eta(), t0 + static_cast<double>(src.size()) / scene_.fs, period_s);
   const double scale = peak / 0.5;
   // Pass 2: the receiver's events.
-  const auto ev = lk.receive_events(src, scale, block);
+  const auto ev = lk.receive_events(src, scale, block, on_block);
   const long s0 = std::lround(t0 * scene_.fs);
   auto pend = lk.prepare(ev, n, static_cast<double>(s0) / scene_.fs, schedule);
   if (!scene_.receiver.metrics.any()) {  // no metric named: no third pass (the fields set to NaN)

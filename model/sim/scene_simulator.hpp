@@ -32,6 +32,8 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -177,9 +179,13 @@ class SceneSimulator {
   // decode() of a capture read in blocks of `block` samples (three passes: its peak, the
   // receiver, the metrics over a sliding window of the filtered stream): the same detections,
   // bit for bit, in memory independent of the capture's length (the window spans the bursts
-  // whose metrics are pending, about one burst period).
+  // whose metrics are pending, about one burst period). peak: the capture's max |x| when the
+  // caller has it (the first pass is skipped; it must be that maximum); on_block: called with
+  // every block of the capture, in order, as the receiver's pass reads it (a caller's own scan
+  // without a read of its own).
   std::vector<Detection> decode_stream(const std::string& family, CaptureSource& src, double period_s = 0,
-                                       std::size_t block = std::size_t{1} << 20);
+                                       std::size_t block = std::size_t{1} << 20, std::optional<double> peak = {},
+                                       const std::function<void(std::span<const double>)>& on_block = {});
 
   // The receiver of the scene's precision over a stream of volts at the scene's input scale
   // (noise.adc.full_scale_v, else receiver.full_scale_v; decode() instead normalizes to the
