@@ -111,9 +111,17 @@ void check_file(const std::string& path, const std::string& precision) {
   EXPECT_EQ(src.size(), whole.samples.size());
   EXPECT_EQ(src.sample_rate(), whole.sample_rate);
   EXPECT_EQ(src.t0(), whole.t0);
+  double peak = 0;
+  for (double v : whole.samples) peak = std::max(peak, std::abs(v));
   for (std::size_t block : {std::size_t{64}, std::size_t{997}, std::size_t{4096}, std::size_t{1} << 20}) {
     SCOPED_TRACE(path + ", " + precision + ", block " + std::to_string(block));
     expect_same(ref, sim.decode_stream("Gold4", src, 0.002, block));
+    // The caller's peak and block scan (decode's clipping scan): the same detections, and the
+    // scan sees every sample once, in order.
+    std::vector<double> seen;
+    expect_same(ref, sim.decode_stream("Gold4", src, 0.002, block, peak,
+                                       [&](std::span<const double> x) { seen.insert(seen.end(), x.begin(), x.end()); }));
+    EXPECT_EQ(seen, whole.samples);
   }
 }
 
