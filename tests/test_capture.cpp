@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdint>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +17,7 @@
 #include <sstream>
 
 #include "model/sim/capture.hpp"
+#include "model/sim/capture_stream.hpp"
 #include "model/base/error.hpp"
 
 using namespace ranging;
@@ -593,4 +596,36 @@ TEST(DecodeCli, ARateTooLowForTheReceiverIsRefusedNamingTheRate) {
   EXPECT_NE(r.err.find("(1 MS/s, 5 samples per carrier cycle); lower receiver.threshold, raise the sample rate"),
             std::string::npos)
       << r.err;
+}
+
+// The CSV reader's numbers (a fast path through std::from_chars, strtod for the rest) are
+// strtod's: the same value to the bit, and refused exactly when strtod does not read the whole
+// cell or reports ERANGE.
+TEST(Capture, CsvNumbersAreReadExactlyAsStrtodReadsThem) {
+  const std::vector<std::string> cells = {
+      "1.234567890e-03", "+1.5e-3", "-0.000000000e+00", "0", ".5", "1.", "1.e5", "-.5E-3", "0x1p-3",
+      "1e-310", "4.9e-324", "2.2250738585072014e-308", "1.7976931348623157e308", "1e309", "9007199254740993",
+      "1.00000000000000011102230246251565404236316680908203125", "1e", "1e+", "12abc", "0x", "infinity", "-nan"};
+  for (const auto& s : cells) {
+    SCOPED_TRACE(s);
+    errno = 0;
+    char* end = nullptr;
+    const double want = std::strtod(s.c_str(), &end);
+    const bool ok = end == s.c_str() + s.size() && errno != ERANGE && std::isfinite(want);
+    const std::string text = "0," + s + "\n2e-7," + s + "\n4e-7,0\n";
+    try {
+      const Capture c = parse_capture_csv(text, "n.csv");
+      ASSERT_TRUE(ok) << "read a cell strtod refuses";
+      EXPECT_EQ(std::memcmp(&c.samples[0], &want, sizeof want), 0) << c.samples[0] << " != " << want;
+      // the streamed reader's value (csv_row_value) too
+      const fs::path p = fs::path(::testing::TempDir()) / ("num_" + std::to_string(::getpid()) + ".csv");
+      write(p.string(), text);
+      CaptureSource src(p.string());
+      std::vector<double> buf(3);
+      ASSERT_EQ(src.read(buf), 3u);
+      EXPECT_EQ(std::memcmp(&buf[1], &want, sizeof want), 0);
+    } catch (const InputError& e) {
+      EXPECT_FALSE(ok) << "refused a cell strtod reads: " << e.what();
+    }
+  }
 }
