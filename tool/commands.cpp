@@ -39,9 +39,10 @@ constexpr Command kCommands[] = {
      "(T_d-max), Table 6 (v_max), Figures 13-15 (PNG via scripts/plot_section4.py) and a\n"
      "generated Markdown document comparing the paper's values with ours."},
     {"decode", cmd_decode, "decode a recorded capture (oscilloscope CSV or WAV)",
-     "Decode a capture: oscilloscope CSV (header lines, then rows 'time_s,volts'; ';', tab or\n"
-     "space separators too) or WAV (8/16/24/32-bit PCM, 32/64-bit float), t = 0 at the start\n"
-     "of transmission of the first burst. The receiver (bandpass, correlator bank, peak\n"
+     "Decode a capture: oscilloscope CSV (header lines, then rows 'time_s,volts[,more\n"
+     "channels]'; ';', tab or space separators too; one column of samples with --sample-rate)\n"
+     "or WAV (8/16/24/32-bit PCM, 32/64-bit float; --channel picks one of several), t = 0 at\n"
+     "the start of transmission of the first burst. The receiver (bandpass, correlator bank, peak\n"
      "detector) adapts to the file's sample rate (it must be an integer multiple of the\n"
      "200 kHz carrier); its latency and the Pearson references are simulated with the\n"
      "calibrated transducers (docs/scenes.md) unless --references gives recorded ones\n"
