@@ -75,9 +75,9 @@ std::string csv_capture(std::size_t n) {
   c.samples.assign(n, 0.01);
   return ranging::capture_csv(c);
 }
-std::string wav_capture(std::size_t n) {
+std::string wav_capture(std::size_t n, double rate = 5e6) {
   ranging::Capture c;
-  c.sample_rate = 5e6;
+  c.sample_rate = rate;
   c.samples.assign(n, 0.01);
   return ranging::capture_wav(c, ranging::WavFormat::Pcm16);
 }
@@ -220,6 +220,10 @@ std::vector<Case> catalogue() {
        {"x.wav: byte 36", "declares 4000 bytes, the file holds 100"}},
       {"wav: fmt chunk past the end", {{"x.wav", wav_fmt_long}}, dec + "{d}/x.wav", {"x.wav: byte 12", "fmt chunk"}},
       {"wav: zero-length file", {{"x.wav", ""}}, dec + "{d}/x.wav", {"x.wav: byte 0: empty file"}},
+      {"wav: a scope's 1 GS/s, above the receiver's 500 MS/s", {{"x.wav", wav_capture(4000, 1e9)}}, dec + "{d}/x.wav",
+       {"x.wav: sample rate 1000 MS/s is above what the receiver takes (500 MS/s)", "decimate"}},
+      {"scene: sample_rate above 500 MS/s", {{"s.yaml", "sample_rate: 600000000\ngeometry:\n  distances_m: [0.5]\n"}},
+       "simulate {d}/s.yaml --quiet", {"s.yaml:1: sample_rate: 600 MS/s is above what the receiver takes"}},
       {"wav: --channel the file lacks", {{"x.wav", wav_capture(50)}}, dec + "{d}/x.wav --channel 2",
        {"x.wav: byte 36: channel 2 is out of range", "valid 1..1"}},
       {"csv: --channel the rows lack", {{"x.csv", csv_capture(3000)}}, dec + "{d}/x.csv --channel 3",
