@@ -180,10 +180,11 @@ int cmd_decode(const Args& args) {
   // The receiver needs an integer number of samples per carrier cycle.
   constexpr double carrier = 200e3;
   auto check_rate = [&](double rate, const std::string& file) {
-    if (rate > 500e6) {  // as a scene's sample_rate: one sample per clock of at most 500 MHz
+    if (rate > kMaxClockHz) {  // as a scene's sample_rate: one sample per clock at most
       std::ostringstream os;
       os.precision(9);
-      os << file << ": sample rate " << rate / 1e6 << " MS/s is above what the receiver takes (500 MS/s); "
+      os << file << ": sample rate " << rate / 1e6 << " MS/s is above what the receiver takes ("
+         << kMaxClockHz / 1e6 << " MS/s); "
          << "decimate the capture first (the paper's 5 MS/s is 25 samples per carrier cycle)";
       throw InputError(os.str());
     }

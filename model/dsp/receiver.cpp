@@ -84,7 +84,7 @@ void validate(const ReceiverConfig& cfg) {
   }
   validate(cfg.reference_transducer, cfg.fs);
   validate(cfg.detector);
-  require_in_range("hardware.clock_hz", cfg.clock_hz, 1e6, 500e6);
+  require_in_range("hardware.clock_hz", cfg.clock_hz, 1e6, kMaxClockHz);
   const double cycles = cfg.clock_hz / cfg.fs;
   if (std::abs(cycles - std::round(cycles)) > 1e-9 * cycles || cycles < 1) {
     std::ostringstream os;

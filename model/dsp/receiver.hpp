@@ -36,6 +36,10 @@ struct SystemConfig {
   int c_frac = 16;  // fraction bits of the speed register (um per sample); frac_bits + c_frac < 32
 };
 
+// The highest system clock a configuration may name (hardware.clock_hz), and so the highest
+// sample rate the receiver takes (one sample per clock at most).
+inline constexpr double kMaxClockHz = 500e6;
+
 struct ReceiverConfig {
   std::string name = "default";
   std::string family = "Gold4";          // code family (ranging codes --list)

@@ -57,7 +57,7 @@ SystemDesign system_design(const ReceiverDesign& d) { return system_design(d, sy
 SystemDesign system_design(const ReceiverDesign& d, const SystemOptions& options) {
   SystemOptions opt = options;
   if (opt.clk_hz == 0) opt.clk_hz = d.config.clock_hz;
-  require_in_range("clk_hz", opt.clk_hz, 1e6, 500e6);
+  require_in_range("clk_hz", opt.clk_hz, 1e6, kMaxClockHz);
   require_in_range("system.max_range_m", opt.max_range_m, 0.01, 100.0);
   require_in_range("system.baud", opt.baud, 1200.0, 12e6);
   require_in_range("system.calibration_distance_m", opt.calibration_distance_m, 0.01, 10.0);

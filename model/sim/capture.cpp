@@ -35,20 +35,19 @@ namespace {
 // glibc's strtod) when it reads a normal value; everything else (a leading '+' or space, hex,
 // inf, nan, zero, subnormals, overflow) goes to strtod itself. (Checked against strtod on 6 M
 // strings: random characters, doubles in %e/%g/%f/%a/%E/%+e, the subnormal and overflow edges.)
-double read_decimal(const char* p, const char* end, const char** stop, bool* range_error) {
+struct Decimal {
+  double value;
+  const char* end;   // past the last character read
+  bool range_error;  // strtod's ERANGE
+};
+Decimal read_decimal(const char* p, const char* end) {
   double v = 0;
   const auto r = std::from_chars(p, end, v);
-  if (r.ec == std::errc() && std::isnormal(v)) {
-    *stop = r.ptr;
-    *range_error = false;
-    return v;
-  }
+  if (r.ec == std::errc() && std::isnormal(v)) return {v, r.ptr, false};
   char* e = nullptr;
   errno = 0;
   v = std::strtod(p, &e);
-  *stop = e;
-  *range_error = errno == ERANGE;
-  return v;
+  return {v, e, errno == ERANGE};
 }
 
 }  // namespace
@@ -66,9 +65,7 @@ double csv_row_value(const std::string& line, int cell) {
     }
   }
   while (*p == ' ' || *p == '\t' || *p == '"') ++p;
-  const char* stop = nullptr;
-  bool range = false;
-  return read_decimal(p, line.c_str() + line.size(), &stop, &range);
+  return read_decimal(p, line.c_str() + line.size()).value;
 }
 namespace {
 
@@ -87,10 +84,9 @@ std::string trim(const std::string& s) {
 bool parse_number(const std::string& cell, double& out) {
   if (cell.empty()) return false;
   const char* b = cell.c_str();
-  const char* end = nullptr;
-  bool range = false;
-  out = read_decimal(b, b + cell.size(), &end, &range);
-  return end == b + cell.size() && !range;
+  const Decimal d = read_decimal(b, b + cell.size());
+  out = d.value;
+  return d.end == b + cell.size() && !d.range_error;
 }
 
 // The cells of one line. Separator (csv_separator): ';' if the line has one (a European export;
@@ -223,7 +219,7 @@ CsvCaptureScan::CsvCaptureScan(std::string origin, const CaptureRead& how)
     : origin_(std::move(origin)), channel_(how.channel), given_rate_(how.sample_rate) {
   if (channel_ < 1) throw InputError(origin_ + ": channel " + std::to_string(channel_) + " is out of range; valid >= 1");
   if (!(given_rate_ >= 0 && given_rate_ <= 1e12)) {
-    throw InputError(origin_ + ": sample rate " + std::to_string(given_rate_) + " Hz is out of range; valid (0, 1e12]");
+    throw InputError(origin_ + ": sample rate " + std::to_string(given_rate_) + " Hz is out of range; valid [0, 1e12] (0: the file's own)");
   }
 }
 

@@ -15,7 +15,7 @@ namespace {
 constexpr std::size_t kWavBlockBytes = std::size_t{1} << 20;
 }
 
-CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how) : path_(path), channel_(how.channel) {
+CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how) : path_(path) {
   std::string ext;
   if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });

@@ -91,7 +91,6 @@ class CaptureSource {
   explicit CaptureSource(const std::string& path, const CaptureRead& how = {});
   ~CaptureSource();
   int channels() const { return channels_; }  // how many the file has
-  int channel() const { return channel_; }
   double file_rate() const { return file_rate_; }  // the rate the file states (0: none)
   double sample_rate() const { return rate_; }
   double t0() const { return t0_; }
@@ -105,7 +104,7 @@ class CaptureSource {
  private:
   std::string path_;
   bool csv_ = false;
-  int channel_ = 1, channels_ = 1, cell_ = 1;
+  int channels_ = 1, cell_ = 1;
   double rate_ = 0, t0_ = 0, file_rate_ = 0;
   std::size_t n_ = 0, pos_ = 0;
   CaptureMeta meta_;

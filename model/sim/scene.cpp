@@ -281,16 +281,16 @@ void derive_receiver_config(Scene& s, const YAML::Node& root, const std::string&
   // MS/s into 30 MHz) gets the next multiple of it that the system can run at (the board's PLL
   // makes it exactly and system.baud divides it, so the RTL and the bitstream flow accept it;
   // else the next multiple), said in a warning. The model's results do not depend on the clock.
-  if (rc.fs > 500e6) {  // one sample per clock at most, and the clock is at most 500 MHz (validate)
+  if (rc.fs > kMaxClockHz) {  // one sample per clock at most, and the clock is at most kMaxClockHz
     std::ostringstream os;
     os.precision(9);
-    os << "sample_rate: " << rc.fs / 1e6 << " MS/s is above what the receiver takes (500 MS/s: one sample per "
-       << "clock of at most 500 MHz, hardware.clock_hz); decimate the signal first (the paper's 5 MS/s is 25 "
-       << "samples per carrier cycle)";
+    os << "sample_rate: " << rc.fs / 1e6 << " MS/s is above what the receiver takes (" << kMaxClockHz / 1e6
+       << " MS/s: one sample per clock of at most " << kMaxClockHz / 1e6 << " MHz, hardware.clock_hz); "
+       << "decimate the signal first (the paper's 5 MS/s is 25 samples per carrier cycle)";
     throw InputError(yaml::locate(root, origin, os.str()));
   }
   if (const double per = rc.clock_hz / rc.fs;
-      per > 0 && std::abs(per - std::round(per)) > 1e-9 * per && std::ceil(per) * rc.fs <= 500e6) {
+      per > 0 && std::abs(per - std::round(per)) > 1e-9 * per && std::ceil(per) * rc.fs <= kMaxClockHz) {
     double k = std::ceil(per);
     bool system_ok = false;
     for (double m = k; m * rc.fs <= 275e6 && !system_ok; ++m) {  // the iCE40 PLL's output tops out below 275 MHz
