@@ -326,9 +326,20 @@ module bandpass_sos #(
       localparam integer R0_I = (6 - PH) % 6;
       localparam [2:0] R0 = R0_I[2:0];
       reg [2:0] r;
+      wire [2:0] nr = (r == 3'd5) ? 3'd0 : r + 3'd1;    // the next slot (the slot a read is for)
+      // Decodes of r, registered beside it: one flip-flop each, not a 3-bit compare, in front of
+      // the operand muxes, the dropped bit d0 and the accumulator's first-sum select.
+      reg r_is2, r_isd;                                    // r == 2; r == 2 or r == 5 (a D slot)
       always @(posedge clk) begin
-        if (rst) r <= R0;
-        else if (run) r <= (r == 3'd5) ? 3'd0 : r + 3'd1;
+        if (rst) begin
+          r <= R0;
+          r_is2 <= (R0 == 3'd2);
+          r_isd <= (R0 == 3'd2) || (R0 == 3'd5);
+        end else if (run) begin
+          r <= nr;
+          r_is2 <= (nr == 3'd2);
+          r_isd <= (nr == 3'd2) || (nr == 3'd5);
+        end
       end
       // Operands (sign-extended to DW): section a reads signal A (its input) and
       // A+1 (its output history); section b reads A+1 and B+1.
@@ -386,7 +397,6 @@ module bandpass_sos #(
           raddr = (clr || !ok) ? 4'd8 : {1'b0, sec, a};
         end
       endfunction
-      wire [2:0] nr = (r == 3'd5) ? 3'd0 : r + 3'd1;    // the slot the read is for
       reg  [3:0] pa;
       always @(*) begin
         case (nr)
@@ -418,9 +428,9 @@ module bandpass_sos #(
       reg  [COEF_W-1:0] cf;
       reg               dsel;            // D product: q is x2, else q = ~p
       always @(*) begin
-        dsel = (r == 3'd2) || (r == 3'd5);
-        p = (r == 3'd2) ? a_x0 : sx(prd);
-        qv = (r == 3'd2) ? a_x2 : sx(qrd);
+        dsel = r_isd;
+        p = r_is2 ? a_x0 : sx(prd);
+        qv = r_is2 ? a_x2 : sx(qrd);
         case (r)
           3'd0:    cf = NA2A;
           3'd1:    cf = NA1A;
@@ -441,8 +451,8 @@ module bandpass_sos #(
       localparam [AC+COEF_W-1:0] IAW = {{AC{B0A[COEF_W-1]}}, B0A} + RNDW;
       localparam [AC+COEF_W-1:0] IBW = {{AC{B0B[COEF_W-1]}}, B0B} + RNDW;
       localparam [AC-1:0] IA = IAW[AC-1:0], IB = IBW[AC-1:0], I0 = RNDW[AC-1:0];
-      wire [AC-1:0] init = !d0 ? I0 : (r == 3'd2) ? IA : IB;
-      wire first = (r == 3'd2) || (r == 3'd5);
+      wire [AC-1:0] init = !d0 ? I0 : r_is2 ? IA : IB;
+      wire first = r_isd;
 
       reg signed [COEF_W-1:0] mul_a;
       reg signed [DW-1:0]     mul_b;
@@ -476,9 +486,9 @@ module bandpass_sos #(
       assign pair_y[i*DATA_W +: DATA_W] = y_new;
 
       // Writes: a's sum is final at r5, b's at r2; only for valid waves.
-      assign wr[A] = run && (r == 3'd5) && wv[DA / 6];
+      assign wr[A] = run && r_isd && !r_is2 && wv[DA / 6];   // r == 5
       if (HAS_B) begin : g_wb
-        assign wr[B] = run && (r == 3'd2) && wv[DB / 6];
+        assign wr[B] = run && r_is2 && wv[DB / 6];
       end
     end
   end else begin : g_seq

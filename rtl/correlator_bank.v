@@ -47,7 +47,8 @@
 //       negation between the memory and the multiplier), which costs one priming clock per
 //       output.
 //     Combiner (no multiplier): per output, one round per code; each round reads the CHIPS
-//       taps F[k - (CHIPS-1-m) CHIP_STEP] from the F history (one per clock) into two
+//       taps F[k - (CHIPS-1-m) CHIP_STEP] from the F history (one per clock; the read
+//       address steps from a register holding the next address, mod FN) into two
 //       COMB_W accumulators (re, im; C +- F on one adder each), then quantizes them into
 //       the Cq registers (and code j's word of the group buffer's Cq memory) and clears
 //       them: CHIPS + 2 clocks per round, (CHIPS + 2) CODES per output (81 at the
@@ -589,10 +590,36 @@ module correlator_bank #(
   reg [2*CHIP_W-1:0] f_rd;
   wire [FA_W-1:0] f_wptr_next = (f_wptr == F_LAST) ? {FA_W{1'b0}} : f_wptr + 1'b1;
   wire [FA_W-1:0] f_oldest    = (f_wptr_next == F_LAST) ? {FA_W{1'b0}} : f_wptr_next + 1'b1;
-  wire [FA_W:0]   f_rptr_step = {1'b0, f_rptr} + STEP_A;
-  /* verilator lint_off UNUSEDSIGNAL */
-  wire [FA_W:0]   f_rptr_wrap = f_rptr_step - FN_A;  // used only when >= 0: top bit is 0
-  /* verilator lint_on UNUSEDSIGNAL */
+  // One chip step back in the F ring: v + CHIP_STEP, less FN when that is >= FN.
+  function [FA_W-1:0] f_adv;
+    input [FA_W-1:0] v;
+    /* verilator lint_off UNUSEDSIGNAL */
+    reg   [FA_W:0]   s, w;
+    /* verilator lint_on UNUSEDSIGNAL */
+    begin
+      s = {1'b0, v} + STEP_A;
+      w = s - FN_A;  // used only when s >= FN: its top bit is 0
+      f_adv = (s >= FN_A) ? w[FA_W-1:0] : s[FA_W-1:0];
+    end
+  endfunction
+  // f_rnx = f_adv(f_rptr), loaded beside f_rptr: f_rptr drives the memory's read address and
+  // takes f_rnx in C_RUN, so the step's adder and compare sit on f_rnx's own loop and not
+  // between the read-address register (placed by the EBR) and its input.
+  reg [FA_W-1:0]  f_rnx;
+  // f_adv(f_oldest) = (f_wptr + 2 + CHIP_STEP) mod FN as one modular add of a constant (with
+  // CHIPS >= 2, FN > CHIP_STEP), not three chained modular steps after f_wptr.
+  localparam integer K2_I = (CHIPS >= 2) ? (2 + CHIP_STEP) % FN : 0;
+  localparam [FA_W:0] K2_A = K2_I[FA_W:0];
+  wire [FA_W-1:0] f_oldest_adv;
+  if (CHIPS >= 2) begin : g_oldest_adv
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [FA_W:0] s2 = {1'b0, f_wptr} + K2_A;
+    wire [FA_W:0] w2 = s2 - FN_A;  // used only when s2 >= FN: its top bit is 0
+    /* verilator lint_on UNUSEDSIGNAL */
+    assign f_oldest_adv = (s2 >= FN_A) ? w2[FA_W-1:0] : s2[FA_W-1:0];
+  end else begin : g_oldest_adv1
+    assign f_oldest_adv = f_adv(f_oldest);
+  end
   wire signed [CHIP_W-1:0] f_rd_re = f_rd[2*CHIP_W-1:CHIP_W];
   wire signed [CHIP_W-1:0] f_rd_im = f_rd[CHIP_W-1:0];
   wire signed [CA_W-1:0] f_re_x = {{(CA_W-CHIP_W){f_rd_re[CHIP_W-1]}}, f_rd_re};
@@ -708,7 +735,7 @@ module correlator_bank #(
       a_la <= 0; a_lb <= 0; fq_pend <= 1'b0; fq_lane <= 1'b0;
       fres_valid <= 1'b0;
       c_state <= C_IDLE; c_m <= 0; c_neg <= 1'b0; c_iss1 <= 1'b0; c_dv1 <= 1'b0;
-      c_j <= 0; f_wptr <= F_LAST; f_rptr <= 0; f_old <= 0; f_cnt <= 0; f_dist <= 0;
+      c_j <= 0; f_wptr <= F_LAST; f_rptr <= 0; f_rnx <= f_adv({FA_W{1'b0}}); f_old <= 0; f_cnt <= 0; f_dist <= 0;
       ca_re <= 0; ca_im <= 0;
       cq_valid <= 1'b0;
       cq_j <= 0; sq_p <= 1'b0; sq_la <= 0; sq_lb <= 0;
@@ -842,7 +869,8 @@ module correlator_bank #(
           c_iss1 <= 1'b1;
           c_neg <= !code_rom(c_j, c_m);   // c_j does not change before the chip is added
           c_dv1 <= (f_dist < f_cnt);
-          f_rptr <= (f_rptr_step >= FN_A) ? f_rptr_wrap[FA_W-1:0] : f_rptr_step[FA_W-1:0];
+          f_rptr <= f_rnx;
+          f_rnx <= f_adv(f_rnx);
           f_dist <= f_dist - STEP_D;
           if (c_m == C_LAST) c_state <= C_DRAIN;
           c_m <= c_m + 1'b1;
@@ -863,6 +891,7 @@ module correlator_bank #(
             c_j <= c_j + 1'b1;
             c_m <= 0;
             f_rptr <= f_old;
+            f_rnx <= f_adv(f_old);
             f_dist <= DIST0;
             c_state <= C_RUN;
           end
@@ -883,6 +912,7 @@ module correlator_bank #(
         if (f_cnt != FN_N) f_cnt <= f_cnt + 1'b1;
         // oldest combiner tap: k - (CHIPS-1) CHIP_STEP = k + 1 (mod FN)
         f_rptr <= f_oldest;
+        f_rnx <= f_oldest_adv;
         f_old <= f_oldest;
         f_dist <= DIST0;
         c_m <= 0;
@@ -968,6 +998,7 @@ module correlator_bank #(
              w_la <= NP_L && w_lb <= NW_L);
       if (c_state == C_RUN) assert(c_m <= C_LAST);
       assert(f_wptr <= F_LAST && f_rptr <= F_LAST && f_old <= F_LAST && f_cnt <= FN_N);
+      assert(f_rnx == f_adv(f_rptr));
       if (cq_valid) assert(cq_j <= J_LAST);
       if (pw_valid) assert(pw_j <= J_LAST);
       if (q_we) assert(q_wj <= J_LAST);

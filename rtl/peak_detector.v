@@ -48,7 +48,9 @@
 //      gives 0. Both rules equal the model's floor + min(cap) / trunc + clamp for every input.
 //    The steps run on one adder of DA = max(WEIGHTED_W-SCORE_W+1, norm bits+2, (W+3)/2) bits
 //    (33 at the defaults): a score step in one clock, a fraction step in two (low half, its
-//    carry registered, then high half), so no carry chain is longer than DA.
+//    carry registered, then high half, at the top of the adder), so no carry chain is longer
+//    than DA, and every step's sign (the next add / subtract and quotient bit) is the adder's
+//    bit DA-1.
 //  - |dQ| = |Q_next - Q_prev| uses one subtractor twice (Q_prev - Q_next, then Q_next -
 //    Q_prev if that was negative: no negation adder; carry-select), then Q_prev + Q_next (in
 //    two clocks, half the chain each) and den = 4Q - 2(Q_prev + Q_next) (carry-select), in the
@@ -326,21 +328,26 @@ module peak_detector #(
   //     (R = Q >> (SCORE_W+1) < 2^(QW-SCORE_W-1)) fits QW-SCORE_W+1. After a first quotient bit
   //     1 the score is the cap and the later (possibly wrapped) bits are not used.
   //   fraction (dsel 0): two clocks per step (dv_ph): the low DA bits, their carry registered
-  //     (dv_cl), then the high W+2-DA bits; dv_rn (the step's add / subtract) changes only after
+  //     (dv_cl), then the high W+1-DA bits; dv_rn (the step's add / subtract) changes only after
   //     the high pass, and dv_rm keeps r[DA-1] (bit DA of 2r) that the low pass overwrote.
+  //     The high pass sits at the top of the adder, above SH = 2 DA - 1 - W low bits that pass
+  //     its carry-in dv_cl up (ones plus zeros plus dv_cl): the step's sign is st[DA-1] in
+  //     every step, straight from the carry chain (no multiplexer after it).
+  localparam integer SH = 2 * DA - 1 - W;
+  if (SH < 1) begin : g_bad_sh
+    initial $error("peak_detector: divider adder DA = %0d too narrow for W = %0d (2 DA - 1 - W = %0d < 1)", DA, W, SH);
+  end
   reg          dv_rn, dv_ph, dv_cl, dv_rm;
   /* verilator lint_off UNUSEDSIGNAL */
   wire [DA+W+1:0] dv_sw = {{DA{dv_rn}}, dv_rn, dv_r, dv_q[KM-1]};   // 2r + bit, sign-extended
   wire [2*DA-1:0] dv_dw = {{(2*DA-W){1'b0}}, dv_d};
   /* verilator lint_on UNUSEDSIGNAL */
-  wire [DA-1:0] st_a  = dv_ph ? {dv_sw[2*DA-1:DA+1], dv_rm} : dv_sw[DA-1:0];
-  wire [DA-1:0] st_b  = (dv_ph ? dv_dw[2*DA-1:DA] : dv_dw[DA-1:0]) ^ {DA{~dv_rn}};
+  wire [DA-1:0] st_a  = dv_ph ? {dv_sw[W:DA+1], dv_rm, {SH{1'b1}}} : dv_sw[DA-1:0];
+  wire [DA-1:0] st_b  = dv_ph ? {dv_dw[W:DA] ^ {(W-DA+1){~dv_rn}}, {SH{1'b0}}}
+                              : dv_dw[DA-1:0] ^ {DA{~dv_rn}};
   wire          st_ci = dv_ph ? dv_cl : ~dv_rn;
   wire [DA:0]   st    = {1'b0, st_a} + {1'b0, st_b} + {{DA{1'b0}}, st_ci};
-  /* verilator lint_off UNUSEDSIGNAL */
-  wire [2*DA-1:0] st_hi = {st[DA-1:0], dv_r[DA-1:0]};   // after the high pass: r' = st_hi[W-1:0]
-  /* verilator lint_on UNUSEDSIGNAL */
-  wire dv_sgn = dv_ph ? st_hi[W] : st[DA-1];   // the sign of the step's result
+  wire dv_sgn = st[DA-1];   // the sign of the step's result (score step or fraction high pass)
   wire dv_last = dv_ph || (dsel != 2'd0);      // the step's last clock
   // den = 4 Q - 2 (Q_prev + Q_next) (S_P2, mod 2^W) as a two-segment carry-select subtractor
   localparam integer EH = W / 2;
@@ -608,7 +615,7 @@ module peak_detector #(
         fmag <= {FR_W{1'b0}};
       end
       S_DIV: begin
-        if (dv_ph) dv_r <= st_hi[W-1:0];
+        if (dv_ph) dv_r[W-1:DA] <= st[DA-2:SH];
         else begin
           dv_r[DA-1:0] <= st[DA-1:0];
           dv_rm <= dv_r[DA-1];

@@ -38,7 +38,9 @@
 //
 // Timing:    sequential (no DSP): the offset is subtracted over two clocks (low
 //            half at capture, high half in the first step-back cycle), up to
-//            CODES-1 cycles to step back to code j's burst, 2-3 cycles for the
+//            CODES-1 cycles to step back to code j's burst (t - PERIOD_T or
+//            t - CYCLE as a carry-select subtractor: the constant's low bits,
+//            and t's high bits or those minus 1), 2-3 cycles for the
 //            ToF (its subtractor is registered; two more per cycle stepped back
 //            and across a counter wrap),
 //            TOF_W cycles of shift-add (one C_W+1-bit adder) multiply with the
@@ -101,6 +103,9 @@ module tof_distance #(
   localparam integer CNT_W = ($clog2(TOF_W) > KW + 1 ? $clog2(TOF_W) : KW + 1);
   localparam integer CYCLE = CODES * PERIOD_T;
   generate
+    if ($clog2(CODES * PERIOD_T + 1) >= TIME_W + 2) begin : g_bad_cycle
+      initial $error("tof_distance: CODES * PERIOD_T = %0d needs more bits than the burst times' %0d", CODES * PERIOD_T, TIME_W + 2);
+    end
     if (TOF_W > DW - 1) begin : g_bad_tof_w
       initial $error("tof_distance: TOF_W %0d wider than A - t 2^FRAC_W can be (max(TIME_W + FRAC_W + 1, OFF_W) + 1 = %0d)", TOF_W, DW - 1);
     end
@@ -153,8 +158,14 @@ module tof_distance #(
   // one subtractor steps t back (a period in BACK, a cycle in TOF); its sign in TOF is t < CYCLE.
   // in_back is state == BACK as a register of its own: the operand select then comes from one
   // flip-flop, not from the state decode, ahead of the TW-bit carry chain (a critical path).
+  // Carry-select: both constants fit the low TL bits, so the high TW-TL bits are t's or t's
+  // minus 1, picked by the low segment's borrow (two short chains side by side, not one of TW).
   reg in_back;
-  wire signed [TW-1:0] t_step = t - (in_back ? PERIOD_T : CYCLE);
+  localparam integer TL = $clog2(CYCLE + 1);          // CYCLE >= PERIOD_T
+  localparam [TL-1:0] PERIOD_L = PERIOD_T, CYCLE_L = CYCLE;
+  wire [TL:0]    ts_lo = {1'b0, t[TL-1:0]} - {1'b0, (in_back ? PERIOD_L : CYCLE_L)};
+  wire [TW-TL-1:0] ts_hi1 = t[TW-1:TL] - 1'b1;
+  wire signed [TW-1:0] t_step = {ts_lo[TL] ? ts_hi1 : t[TW-1:TL], ts_lo[TL-1:0]};
   // sign of t - CYCLE, registered: TOF reads it after TOF0, where t has not changed
   reg t_step_neg;
   always @(posedge clk) t_step_neg <= t_step[TW-1];

@@ -147,6 +147,7 @@ pnr_seed() {
   fi
 }
 running=0
+seed_fmax=""   # "seed:MHz" of every seed (0 when nextpnr failed), for the summary
 for ((seed = 1; seed <= seeds; seed++)); do
   rm -rf "$out/seed-$seed"
   log "nextpnr-ice40 --up5k --package sg48 --freq $freq --seed $seed (log: $out/seed-$seed/nextpnr.log)"
@@ -162,11 +163,13 @@ for ((seed = 1; seed <= seeds; seed++)); do
     mhz=$(grep -o "Max frequency for clock 'clk': [0-9.]*" "$sd/nextpnr.log" | tail -1 | awk '{print $NF}')
     mhz=${mhz:-0}
     log "  seed $seed: Fmax $mhz MHz"
+    seed_fmax+="$seed:$mhz "
     if [[ $pnr_ok == 0 ]] || awk -v a="$mhz" -v b="$best_mhz" 'BEGIN{exit !(a > b)}'; then
       pnr_ok=1; best_seed=$seed; best_mhz=$mhz
     fi
   else
     log "  seed $seed: nextpnr failed"
+    seed_fmax+="$seed:0 "
     [[ $pnr_ok == 0 && $seed == 1 ]] && cp "$sd/nextpnr.log" "$out/nextpnr.log"   # keep the failure for the summary
   fi
 done
@@ -224,9 +227,10 @@ fi
 
 # --- summary -----------------------------------------------------------------------------------
 $py - "$out" "$results" "$gen/system.json" "$bin" "$pnr_ok" "$clk_mhz" "$freq" "$check" \
-    "$(realpath --relative-to="$root" "$config")" "$yosys_s" "$pnr_s" "$root" "$best_seed" "$seeds" <<'EOF'
+    "$(realpath --relative-to="$root" "$config")" "$yosys_s" "$pnr_s" "$root" "$best_seed" "$seeds" \
+    "$seed_fmax" <<'EOF'
 import json, os, re, sys, datetime
-out, results, sysjson, binpath, pnr_ok, clk, freq, check, cfg, ys, ps, root, seed, seeds = sys.argv[1:15]
+out, results, sysjson, binpath, pnr_ok, clk, freq, check, cfg, ys, ps, root, seed, seeds, sfm = sys.argv[1:16]
 pnr_ok, clk, freq, check = pnr_ok == "1", float(clk), float(freq), check == "1"
 
 def cells(path):
@@ -266,6 +270,8 @@ summary = {
         "nextpnr_target_mhz": freq,
         "nextpnr_seed": int(seed) if pnr_ok else None,
         "nextpnr_seeds_tried": int(seeds),
+        # Fmax of every seed tried (0: nextpnr failed), and how many reach 1.1 x the clock
+        "nextpnr_seed_fmax_mhz": {k: float(m) for k, m in (t.split(":") for t in sfm.split())},
         "placed_and_routed": pnr_ok,
         "bitstream": rel(binpath) if binpath else None,
         "yosys_seconds": int(ys), "nextpnr_seconds": int(ps),
@@ -378,6 +384,9 @@ md = [f"# Bitstream summary ({cfg})", "",
       f"| required clock | {clk:g} MHz |",
       f"| nextpnr target (--freq) | {freq:g} MHz |",
       f"| nextpnr seed | {seed if pnr_ok else '-'} (best of {seeds}) |",
+      "| Fmax of each seed | " + (" / ".join(f"{k}: {m:.2f}" for k, m in ic["nextpnr_seed_fmax_mhz"].items())
+                                  or "-") + " MHz |",
+      f"| seeds at >= 1.1 x the clock | {sum(m >= 1.1 * clk - 1e-9 for m in ic['nextpnr_seed_fmax_mhz'].values())} of {seeds} |",
       f"| placed and routed | {'yes' if pnr_ok else 'no: ' + ic.get('nextpnr_error', '')} |",
       f"| Fmax (nextpnr) | {v(ic.get('fmax_mhz'))} MHz |",
       f"| slack at the required clock | {v(ic.get('slack_ns'))} ns |",
