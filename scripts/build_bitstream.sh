@@ -294,10 +294,14 @@ if pnr_ok:
         ic["margin_percent"] = round((best[1]["achieved"] / clk - 1) * 100, 1)
     it = os.path.join(out, "icetime.log")
     if os.path.exists(it):
-        m = re.search(r"Total path delay:\s*([\d.]+)\s*ns\s*\(([\d.]+)\s*MHz\)", open(it).read())
+        text = open(it).read()
+        m = re.search(r"Total path delay:\s*([\d.]+)\s*ns\s*\(([\d.]+)\s*MHz\)", text)
         if m:
             ic["icetime_path_ns"] = float(m.group(1))
             ic["icetime_fmax_mhz"] = float(m.group(2))
+        else:  # say why (a missing chip database: Debian's fpga-icestorm-chipdb)
+            lines = [l for l in text.splitlines() if l.strip() and not l.startswith("//")]
+            ic["icetime_error"] = lines[-1] if lines else "icetime gave no path delay"
 else:
     log = open(os.path.join(out, "nextpnr.log")).read()
     errs = [l for l in log.splitlines() if "ERROR" in l]
@@ -391,7 +395,8 @@ md = [f"# Bitstream summary ({cfg})", "",
       f"| Fmax (nextpnr) | {v(ic.get('fmax_mhz'))} MHz |",
       f"| slack at the required clock | {v(ic.get('slack_ns'))} ns |",
       f"| margin | {v(ic.get('margin_percent'))} % |",
-      f"| icetime critical path | {v(ic.get('icetime_path_ns'))} ns ({v(ic.get('icetime_fmax_mhz'))} MHz) |",
+      (f"| icetime critical path | {v(ic.get('icetime_path_ns'))} ns ({v(ic.get('icetime_fmax_mhz'))} MHz) |"
+       if "icetime_error" not in ic else f"| icetime critical path | not run: {ic['icetime_error']} |"),
       f"| bitstream | {v(ic['bitstream'])} |", ""]
 if modules:
     md += ["## iCE40 resources per module (synth_ice40 -dsp -noflatten)", "",

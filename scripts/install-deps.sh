@@ -11,6 +11,7 @@ packages=(build-essential cmake g++ libgtest-dev libgmock-dev libbenchmark-dev l
           clang libclang-rt-14-dev)  # clang + libFuzzer: tests/fuzz (RANGING_FUZZ=ON)
 if [[ "${1:-}" == "--hardware" ]]; then
   packages+=(verilator iverilog yosys nextpnr-ice40 fpga-icestorm gtkwave
+             fpga-icestorm-chipdb  # icetime's chip database (a Recommends, not installed with --no-install-recommends)
              z3)  # solver of yosys-smtbmc: formal/ (ctest label formal)
 fi
 if [[ "${1:-}" == "--cluster" ]]; then
