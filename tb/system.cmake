@@ -59,7 +59,8 @@ add_custom_target(bitstream
 # features of the `bitstream` target above, several minutes of yosys that --check never reads).
 add_test(NAME bitstream_targets
   COMMAND ${PROJECT_SOURCE_DIR}/scripts/build_bitstream.sh --build-dir ${CMAKE_BINARY_DIR} --no-others --seeds 5
-          --out ${CMAKE_BINARY_DIR}/bitstream-test --results ${CMAKE_BINARY_DIR}/bitstream-test/results --check)
+          --out ${CMAKE_BINARY_DIR}/bitstream-test --results ${CMAKE_BINARY_DIR}/bitstream-test/results --check
+          --min-seeds 4)  # issue 18: 1.1x the clock on at least 4 of seeds 1-5
 # COST: the longest test (~11 min on one core) starts first, so that `ctest -j` runs the rest
 # beside it instead of after it (a fresh clone has no CTestCostData to order by).
 set_tests_properties(bitstream_targets PROPERTIES LABELS "bitstream" TIMEOUT 7200 COST 100000)

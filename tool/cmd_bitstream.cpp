@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -115,6 +116,7 @@ int cmd_bitstream(const Args& args) {
   p.option("--jobs", "N", "seeds placed and routed at the same time (1-99)", "1");
   p.option("--out", "DIR", "work and report folder (default: $TMPDIR/ranging-bitstream-UID-NAME)");
   p.flag("--check", "exit 1 unless the targets of docs/bitstream.md are met (LUT4, SB_MAC16, EBR, Fmax)");
+  p.option("--min-seeds", "K", "with --check: at least K of the seeds must reach 1.1x the clock (1..N)", "1");
   p.flag("--estimates", "also estimate ECP5 and Xilinx 7 resources of this configuration with yosys");
   p.flag("--program", "write the bitstream into the board's flash (iceprog or openFPGALoader)");
   p.option("--bin", "FILE", "with --program: program this bitstream, build nothing");
@@ -123,6 +125,12 @@ int cmd_bitstream(const Args& args) {
   if (board != "icebreaker") throw InputError("option --board: '" + board + "' is not supported; valid: icebreaker");
   const long long seeds = p.integer("--seeds", 1, 1, 99);
   const long long jobs = p.integer("--jobs", 1, 1, 99);
+  const long long min_seeds = p.integer("--min-seeds", 1, 1, 99);
+  if (min_seeds > seeds) {
+    throw InputError("option --min-seeds: " + std::to_string(min_seeds) + " is more than the " + std::to_string(seeds) +
+                     " seed(s) tried; valid: 1.." + std::to_string(seeds) + " (--seeds N)");
+  }
+  if (p.has("--min-seeds") && !p.has("--check")) throw InputError("option --min-seeds: only with --check");
   const bool do_program = p.has("--program");
 
   if (p.has("--bin")) {
@@ -178,7 +186,7 @@ int cmd_bitstream(const Args& args) {
                     " --out " + shell_quote(out.string()) + " --results " + shell_quote(results.string()) + " --seeds " +
                     std::to_string(seeds) + " --jobs " + std::to_string(jobs) + " --no-large";
   if (!p.has("--estimates")) cmd += " --no-others";
-  if (p.has("--check")) cmd += " --check";
+  if (p.has("--check")) cmd += " --check --min-seeds " + std::to_string(min_seeds);
   cmd += " 1>&2";  // progress and the script's summary on stderr; ours on stdout
   const int rc = exit_status(run_shell(cmd));
   if (rc == 2 || rc < 0 || !fs::exists(results / "bitstream.json")) {
@@ -212,7 +220,15 @@ int cmd_bitstream(const Args& args) {
   if (routed) {
     std::cout << "placed and routed: Fmax " << ic.value("fmax_mhz", 0.0) << " MHz at "
               << ic.value("required_clock_mhz", 0.0) << " MHz required (seed " << ic.value("nextpnr_seed", 0)
-              << " of " << seeds << ")\nbitstream " << bin.string() << "\n";
+              << " of " << seeds << ")\n";
+    if (seeds > 1 && ic.contains("nextpnr_seed_fmax_mhz")) {
+      std::map<int, double> by_seed;  // the JSON object's keys sort as text ("10" before "2")
+      for (const auto& [k, v] : ic["nextpnr_seed_fmax_mhz"].items()) by_seed[std::stoi(k)] = v.get<double>();
+      std::cout << "Fmax per seed (MHz):";
+      for (const auto& [k, v] : by_seed) std::cout << " " << k << ": " << v;
+      std::cout << "\n";
+    }
+    std::cout << "bitstream " << bin.string() << "\n";
   } else {
     std::cout << "not placed and routed: " << ic.value("nextpnr_error", std::string("nextpnr failed")) << "\n";
   }
