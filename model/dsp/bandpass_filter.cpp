@@ -392,7 +392,18 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
                      " differs from input size " + std::to_string(in.size()) + "; they must be equal");
   }
   if (in.empty()) return;
-  // Range check once per block.
+  check_input(in);  // once per block
+  const std::int64_t in_scale = std::int64_t{1} << input_shift_;
+  const int qshift = config_.coef_frac;  // acc_frac - data_frac
+  fx_dispatch(config_.rounding, config_.overflow, [&]<Rounding R, Overflow O>() {
+    bandpass_dispatch_sections<R, O>(in.data(), out.data(), in.size(), in_scale, coef_, state_, qshift, data_range_,
+                                     section_events_, bias_ok_, sym_ok_);
+  });
+  for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
+}
+
+void BandpassFixed::check_input(std::span<const std::int64_t> in) const {
+  if (in.empty()) return;
   const std::int64_t lo = fx_min_raw(input_fmt_), hi = fx_max_raw(input_fmt_);
   std::int64_t mn = in[0], mx = in[0];
   for (const std::int64_t v : in) {
@@ -404,13 +415,6 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
       if (v < lo || v > hi) throw_input_range(v);
     }
   }
-  const std::int64_t in_scale = std::int64_t{1} << input_shift_;
-  const int qshift = config_.coef_frac;  // acc_frac - data_frac
-  fx_dispatch(config_.rounding, config_.overflow, [&]<Rounding R, Overflow O>() {
-    bandpass_dispatch_sections<R, O>(in.data(), out.data(), in.size(), in_scale, coef_, state_, qshift, data_range_,
-                                     section_events_, bias_ok_, sym_ok_);
-  });
-  for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
 }
 
 std::int64_t BandpassFixed::execute_raw(std::int64_t x_in) {

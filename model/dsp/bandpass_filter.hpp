@@ -119,6 +119,9 @@ class BandpassFixed final : public BandpassFilter {
   // the sections' recursions.
   using BandpassFilter::execute_block;
   void execute_block(std::span<const std::int64_t> in, std::span<std::int64_t> out);
+  // Throws InputError naming the first sample of `in` outside the signed input_bits range.
+  void check_input(std::span<const std::int64_t> in) const;
+  bool sym() const { return sym_ok_; }  // every numerator is b0 [1, 0, -1] (one-multiply form)
 
   const std::vector<std::int64_t>& section_outputs() const { return out_; }  // last sample, per section
   const std::vector<std::vector<std::int64_t>>& coefficients() const { return coef_; }  // {b0,b1,b2,a1,a2}

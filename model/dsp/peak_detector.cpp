@@ -9,7 +9,7 @@ namespace ranging {
 namespace {
 
 template <class T>
-void best_two(const std::vector<T>& q, int& best, T& second) {
+void best_two(std::span<const T> q, int& best, T& second) {
   best = 0;
   for (int j = 1; j < static_cast<int>(q.size()); ++j) {
     if (q[j] > q[best]) best = j;
@@ -23,7 +23,7 @@ void best_two(const std::vector<T>& q, int& best, T& second) {
 // The candidate's life cycle, the same in both precisions. The output after the candidate's
 // peak is its right neighbour (the parabola's third point).
 template <class Cand, class T>
-void take_right_neighbour(std::optional<Cand>& cand, const std::vector<T>& q) {
+void take_right_neighbour(std::optional<Cand>& cand, std::span<const T> q) {
   if (cand && !cand->has_next) {
     cand->q_next = q[static_cast<std::size_t>(cand->code)];
     cand->has_next = true;
@@ -106,8 +106,8 @@ std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank)
   if (prev_.empty()) prev_.assign(q.size(), 0.0);
   int best;
   double second;
-  best_two(q, best, second);
-  take_right_neighbour(cand_, q);
+  best_two(std::span<const double>(q), best, second);
+  take_right_neighbour(cand_, std::span<const double>(q));
   const std::int64_t n = bank.sample_index();
   const double rho2 = bank.rho2(best);
   const bool gate = rho2 >= cfg_.threshold && bank.energy() >= cfg_.min_energy;
@@ -160,14 +160,16 @@ EventFixed PeakDetectorFixed::make_event(const Candidate& c) const {
 }
 
 std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& bank) {
-  const std::vector<std::uint64_t>& q = bank.weighted_power();
+  return execute(bank.weighted_power(), bank.sample_index(), bank.norm());
+}
+
+std::optional<EventFixed> PeakDetectorFixed::execute(std::span<const std::uint64_t> q, std::int64_t n,
+                                                     std::uint64_t norm) {
   if (prev_.empty()) prev_.assign(q.size(), 0);
   int best;
   std::uint64_t second;
   best_two(q, best, second);
   take_right_neighbour(cand_, q);
-  const std::int64_t n = bank.sample_index();
-  const std::uint64_t norm = bank.norm();
   const bool gate = static_cast<uint128_t>(q[best]) >=
                         static_cast<uint128_t>(thr_q_) * std::max<std::uint64_t>(norm, 1) &&
                     norm >= min_norm_;
@@ -176,7 +178,7 @@ std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& 
                                     static_cast<uint128_t>(cand_->q) * std::max<std::uint64_t>(norm, 1);
   auto out = next_candidate(cand_, gate && better, Candidate{n, best, prev_[best], q[best], 0, second, norm, false}, n,
                             holdoff_, [this](const Candidate& c) { return make_event(c); });
-  prev_ = q;
+  prev_.assign(q.begin(), q.end());
   return out;
 }
 

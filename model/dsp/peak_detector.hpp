@@ -28,6 +28,7 @@
 // (2 den) truncated toward zero (parabolic_fraction), then multiplied by D.
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "model/dsp/correlator_bank.hpp"
@@ -107,6 +108,9 @@ class PeakDetectorFixed {
     cand_.reset();
   }
   std::optional<EventFixed> execute(const CorrelatorBankFixed& bank);
+  // The same from a decimated output's values: Q_j per code, the full-rate sample index and
+  // norm = E >> energy_shift (what the bank overload reads from the bank).
+  std::optional<EventFixed> execute(std::span<const std::uint64_t> q, std::int64_t n, std::uint64_t norm);
   std::optional<EventFixed> flush();
 
   std::uint64_t threshold_q() const { return thr_q_; }   // on score (score_bits fraction)

@@ -1,0 +1,214 @@
+#include "model/dsp/receiver_batch.hpp"
+
+#include <algorithm>
+
+#include "model/base/error.hpp"
+#include "model/dsp/receiver_batch_kernels.hpp"
+
+namespace ranging {
+
+using batch::kBatchLanes;
+using batch::Lanes;
+
+static_assert(ReceiverFixedBatch::kLanes == static_cast<std::size_t>(kBatchLanes));
+
+// The kernels' state, with the arrays BankBatch points into.
+struct ReceiverFixedBatch::Kernels {
+  batch::BandpassBatch bp;
+  batch::BankBatch bank;
+  BandpassFixed filter;        // the scalar objects the constants come from (and the input
+  CorrelatorBankFixed scalar;  //   range check)
+  std::vector<std::int64_t> lo_cos, lo_nsin, taps_rev, sign_mask, weights;
+  std::vector<Lanes> b_re, b_im, y2h, bd_re, bd_im, f_re, f_im, q;
+  OverflowCounter bp_events[kBatchLanes], mix_events[kBatchLanes], chip_events[kBatchLanes], corr_events[kBatchLanes];
+  std::vector<Lanes> in, out;  // a chunk, lane-interleaved
+
+  explicit Kernels(const ReceiverDesign& d)
+      : filter(d.filter, d.config.bandpass), scalar(d.reference, d.config.correlator) {
+    const auto& cfg = filter.config();
+    const auto& coef = filter.coefficients();
+    bp.sections = static_cast<int>(coef.size());
+    for (std::size_t k = 0; k < coef.size(); ++k) {
+      for (int i = 0; i < 5; ++i) bp.coef[k][i] = coef[k][static_cast<std::size_t>(i)];
+    }
+    bp.input_shift = cfg.data_frac - (cfg.input_bits - 1);
+    bp.qshift = cfg.coef_frac;
+    bp.rounding = cfg.rounding;
+    bp.overflow = cfg.overflow;
+    bp.range = fx_range(filter.data_format());
+    // 32 x 32 -> 64 multiplies when every factor fits int32: |coef| < 2^31, the section
+    // outputs |y| <= 2^30 (data_bits <= 31), the aligned input |x| <= 2^data_frac <= 2^29, so
+    // also |x - x2| < 2^31 (the one-multiply numerator).
+    bp.narrow = cfg.coef_bits <= 32 && cfg.data_bits <= 31 && cfg.data_frac <= 29;
+    bp.sym = filter.sym();
+    bp.events = bp_events;
+
+    const auto& l = scalar.layout();
+    const auto& cc = scalar.config();
+    auto& b = bank;
+    b.period = l.period;
+    b.decimation = l.decimation;
+    b.taps = l.taps;
+    b.chips = l.chips;
+    b.codes = l.codes;
+    b.step = l.chip_samples / l.decimation;
+    b.mix_shift = l.mix_shift;
+    b.chip_shift = l.chip_shift;
+    b.corr_shift = l.corr_shift;
+    b.mix_range = fx_range(FixedFormat{cc.mix_bits, l.mix_frac, true, Rounding::RoundHalfUp, Overflow::Saturate});
+    b.chip_range = fx_range(FixedFormat{cc.chip_bits, 0, true, Rounding::RoundHalfUp, Overflow::Saturate});
+    b.corr_range = fx_range(FixedFormat{cc.corr_bits, 0, true, Rounding::RoundHalfUp, Overflow::Saturate});
+    // taps < 2^(tap_bits-1) <= 2^23; Bd < 2^(dec_bits-1); C_q < 2^(corr_bits-1)
+    b.fir_narrow = cc.tap_bits <= 32 && l.dec_bits <= 32;
+    b.power_narrow = cc.corr_bits <= 32;
+    lo_cos = l.lo_cos;
+    for (std::int64_t v : l.lo_sin) lo_nsin.push_back(-v);
+    taps_rev.assign(l.taps_q.rbegin(), l.taps_q.rend());
+    for (const auto& code : d.reference.codes) {
+      for (std::uint8_t chip : code) sign_mask.push_back(chip ? 0 : -1);
+    }
+    weights = l.weights;
+    b.lo_cos = lo_cos.data();
+    b.lo_nsin = lo_nsin.data();
+    b.taps_rev = taps_rev.data();
+    b.sign_mask = sign_mask.data();
+    b.weights = weights.data();
+    b.window = static_cast<std::size_t>(l.window);
+    b.bd_n = static_cast<std::size_t>(l.taps);
+    b.f_n = static_cast<std::size_t>(l.chips - 1) * static_cast<std::size_t>(b.step) + 1;
+    b.mix_events = mix_events;
+    b.chip_events = chip_events;
+    b.corr_events = corr_events;
+    reset();
+  }
+
+  void reset() {
+    auto& b = bank;
+    std::fill(std::begin(bp.y1), std::end(bp.y1), Lanes{});
+    std::fill(std::begin(bp.y2), std::end(bp.y2), Lanes{});
+    bp.x1 = bp.x2 = Lanes{};
+    b_re.assign(static_cast<std::size_t>(b.period), Lanes{});
+    b_im.assign(b_re.size(), Lanes{});
+    y2h.assign(b.window, Lanes{});
+    bd_re.assign(2 * b.bd_n, Lanes{});
+    bd_im.assign(2 * b.bd_n, Lanes{});
+    f_re.assign(2 * b.f_n, Lanes{});
+    f_im.assign(2 * b.f_n, Lanes{});
+    q.assign(static_cast<std::size_t>(b.codes), Lanes{});
+    b.b_re = b_re.data();
+    b.b_im = b_im.data();
+    b.y2h = y2h.data();
+    b.bd_re = bd_re.data();
+    b.bd_im = bd_im.data();
+    b.f_re = f_re.data();
+    b.f_im = f_im.data();
+    b.q = q.data();
+    // CorrelatorBankFixed::reset's positions: the rings' newest slot is the last one
+    b.phase = b.dec_phase = 0;
+    b.y_idx = b.window - 1;
+    b.bd_idx = b.bd_n - 1;
+    b.f_idx = b.f_n - 1;
+    b.acc_re = b.acc_im = b.energy = Lanes{};
+    for (int l = 0; l < kBatchLanes; ++l) bp_events[l] = mix_events[l] = chip_events[l] = corr_events[l] = {};
+  }
+};
+
+ReceiverFixedBatch::ReceiverFixedBatch(const ReceiverDesign& design)
+    : design_(design), frac_bits_(design.config.detector.frac_bits), score_bits_(design.config.correlator.score_bits) {
+  vectorized_ = batch::batch_kernels_available() &&
+                design.config.bandpass.data_bits > 0 &&
+                static_cast<int>(design.filter.sections.size()) <= batch::kBatchMaxSections;
+  if (vectorized_) k_ = std::make_unique<Kernels>(design_);
+}
+
+ReceiverFixedBatch::~ReceiverFixedBatch() = default;
+
+void ReceiverFixedBatch::run(std::span<const std::span<const std::int64_t>> streams,
+                             std::vector<std::vector<EventFixed>>& events, std::vector<OverflowCounter>& overflows) {
+  events.assign(streams.size(), {});
+  overflows.assign(streams.size(), {});
+  for (std::size_t s0 = 0; s0 < streams.size(); s0 += kLanes) {
+    const std::size_t n = std::min(kLanes, streams.size() - s0);
+    if (!vectorized_) {
+      for (std::size_t s = s0; s < s0 + n; ++s) {
+        ReceiverFixed rx(design_);
+        rx.execute_block(streams[s], events[s]);
+        if (auto e = rx.flush_raw()) events[s].push_back(*e);
+        overflows[s] = rx.overflow_events();
+      }
+      continue;
+    }
+    run_lanes(streams.subspan(s0, n), events.data() + s0, overflows.data() + s0);
+  }
+}
+
+void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>> streams, std::vector<EventFixed>* events,
+                                   OverflowCounter* overflows) {
+  Kernels& k = *k_;
+  k.reset();
+  const std::size_t lanes = streams.size();
+  std::size_t len[kBatchLanes] = {}, longest = 0;
+  for (std::size_t l = 0; l < lanes; ++l) {
+    len[l] = streams[l].size();
+    longest = std::max(longest, len[l]);
+  }
+  std::vector<PeakDetectorFixed> det(lanes, PeakDetectorFixed(design_.config.detector, k.scalar.layout(),
+                                                              design_.config.correlator));
+  const int energy_shift = k.scalar.layout().energy_shift;
+  const std::size_t codes = static_cast<std::size_t>(k.bank.codes);
+  std::vector<std::uint64_t> qv(codes);
+  bool open[kBatchLanes] = {};
+  auto finish = [&](std::size_t l) {  // lane l's last sample is in: flush, read its counters
+    if (auto e = det[l].flush()) events[l].push_back(*e);
+    OverflowCounter c = k.bp_events[l];
+    for (const OverflowCounter* o : {&k.mix_events[l], &k.chip_events[l], &k.corr_events[l]}) {
+      c.saturations += o->saturations;
+      c.wraps += o->wraps;
+    }
+    overflows[l] = c;
+    open[l] = false;
+  };
+  for (std::size_t l = 0; l < lanes; ++l) {
+    open[l] = true;
+    if (len[l] == 0) finish(l);
+  }
+  constexpr std::size_t kChunk = 1024;
+  k.in.resize(kChunk);
+  k.out.resize(kChunk);
+  for (std::size_t n0 = 0, n = 0; n0 < longest; n0 += n) {
+    // A chunk ends at the next lane's end, so a lane's counters are read after its last sample.
+    n = std::min(kChunk, longest - n0);
+    for (std::size_t l = 0; l < lanes; ++l) {
+      if (len[l] > n0) n = std::min(n, len[l] - n0);
+    }
+    // interleave: lane l's sample n0 + i at in[i].v[l]; lanes past their end get zeros
+    for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
+      const std::size_t have = l < lanes && len[l] > n0 ? std::min(n, len[l] - n0) : 0;
+      if (have > 0) k.filter.check_input(streams[l].subspan(n0, have));
+      const std::int64_t* src = have > 0 ? streams[l].data() + n0 : nullptr;
+      for (std::size_t i = 0; i < have; ++i) k.in[i].v[l] = src[i];
+      for (std::size_t i = have; i < n; ++i) k.in[i].v[l] = 0;
+    }
+    batch::bandpass_batch(k.bp, k.in.data(), k.out.data(), n);
+    std::size_t i = 0;
+    while (i < n) {
+      bool ready = false;
+      const std::size_t used = batch::bank_feed_batch(k.bank, k.out.data() + i, n - i, &ready);
+      i += used;
+      const std::size_t last = n0 + i - 1;  // index of the last sample fed
+      if (ready) {
+        for (std::size_t l = 0; l < lanes; ++l) {
+          if (!open[l]) continue;
+          for (std::size_t j = 0; j < codes; ++j) qv[j] = static_cast<std::uint64_t>(k.q[j].v[l]);
+          const std::uint64_t norm = static_cast<std::uint64_t>(k.bank.energy.v[l]) >> energy_shift;
+          if (auto e = det[l].execute(qv, static_cast<std::int64_t>(last), norm)) events[l].push_back(*e);
+        }
+      }
+    }
+    for (std::size_t l = 0; l < lanes; ++l) {
+      if (open[l] && len[l] == n0 + n) finish(l);
+    }
+  }
+}
+
+}  // namespace ranging

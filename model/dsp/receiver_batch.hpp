@@ -1,0 +1,54 @@
+#pragma once
+// ReceiverFixedBatch: the fixed receiver (receiver.hpp: bandpass, correlator bank, detector) on
+// up to kLanes independent streams at once, one stream per SIMD lane ("SIMD across streams").
+//
+// Each stream's events and overflow counts are bit for bit what a fresh ReceiverFixed gives for
+// that stream through execute_block and flush_raw (tests/test_receiver_batch.cpp). Streams may
+// differ in length: the lanes run in lockstep to the longest; a lane that has ended is fed
+// zeros whose results are discarded (its detector is flushed and its counters are read at its
+// own last sample), so a batch of streams of similar length wastes little.
+//
+// Where the work is: the bandpass cascade and the bank's full-rate front end and decimated
+// outputs run in receiver_batch_kernels_v4.cpp (AVX-512, 8 lanes of int64); the detector, a few
+// operations per decimated output, runs per lane. On a CPU without AVX-512, or a configuration
+// the kernels do not cover (more than 8 bandpass sections), every stream runs the scalar
+// ReceiverFixed instead: the same results, slower. vectorized() says which.
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "model/dsp/receiver.hpp"
+
+namespace ranging {
+
+class ReceiverFixedBatch {
+ public:
+  static constexpr std::size_t kLanes = 8;
+
+  explicit ReceiverFixedBatch(const ReceiverDesign& design);
+  ~ReceiverFixedBatch();
+  ReceiverFixedBatch(const ReceiverFixedBatch&) = delete;
+  ReceiverFixedBatch& operator=(const ReceiverFixedBatch&) = delete;
+
+  // Runs every stream from reset (ADC codes, signed input_bits; any count: kLanes at a time).
+  // events[s] receives stream s's events (what ReceiverFixed::execute_block then flush_raw
+  // give), overflows[s] its filter + bank saturations and wraps (input quantization excluded:
+  // the codes are given). An out-of-range code throws InputError, as ReceiverFixed does.
+  void run(std::span<const std::span<const std::int64_t>> streams, std::vector<std::vector<EventFixed>>& events,
+           std::vector<OverflowCounter>& overflows);
+
+  bool vectorized() const { return vectorized_; }
+  Event to_float(const EventFixed& e) const { return e.to_float(frac_bits_, score_bits_); }
+
+ private:
+  struct Kernels;  // the SIMD state (receiver_batch.cpp)
+  ReceiverDesign design_;
+  int frac_bits_, score_bits_;
+  bool vectorized_ = false;
+  std::unique_ptr<Kernels> k_;
+  void run_lanes(std::span<const std::span<const std::int64_t>> streams, std::vector<EventFixed>* events,
+                 OverflowCounter* overflows);
+};
+
+}  // namespace ranging

@@ -1,0 +1,85 @@
+#pragma once
+// The SIMD kernels of ReceiverFixedBatch (receiver_batch.hpp): the fixed bandpass cascade and
+// the correlator bank's full-rate front end and decimated outputs, on kBatchLanes independent
+// streams in lockstep, one stream per 64-bit lane. The arithmetic is the scalar model's
+// (BandpassFixed's kernel, CorrelatorBankFixed::feed / decimated_output), operation for
+// operation on exact integers, so every lane is bit for bit the scalar stream: the tests
+// compare them (tests/test_receiver_batch.cpp).
+//
+// receiver_batch_kernels_v4.cpp is compiled for x86-64-v4 (AVX-512 F/DQ/VL/BW) and called only
+// when the CPU has it (batch_kernels_available()); elsewhere ReceiverFixedBatch runs the scalar
+// receiver per stream. This header therefore holds plain data only: no inline code a
+// differently compiled translation unit could share (std containers stay out of the kernel TU).
+#include <cstddef>
+#include <cstdint>
+
+#include "model/dsp/fixed_point.hpp"
+
+namespace ranging::batch {
+
+constexpr int kBatchLanes = 8;
+constexpr int kBatchMaxSections = 8;
+
+// One value per lane, 64-byte aligned (one AVX-512 register).
+struct alignas(64) Lanes {
+  std::int64_t v[kBatchLanes];
+};
+
+// Bandpass cascade: the constants and the state of every lane (BandpassFixed's, per lane).
+struct BandpassBatch {
+  int sections = 0;
+  std::int64_t coef[kBatchMaxSections][5] = {};  // {b0, b1, b2, a1, a2}, coef_frac fraction bits
+  int input_shift = 0;                           // input code << input_shift: the data format
+  int qshift = 0;                                // accumulator -> data: bits dropped (coef_frac)
+  Rounding rounding = Rounding::RoundHalfUp;
+  Overflow overflow = Overflow::Saturate;
+  FxRange range{};                               // the data format
+  bool narrow = false;  // every multiplicand fits int32: 32 x 32 -> 64 multiplies
+  bool sym = false;     // every numerator is b0 [1, 0, -1]: b0 (x - x2), one multiply
+  Lanes x1{}, x2{};     // section 0's input history
+  Lanes y1[kBatchMaxSections] = {}, y2[kBatchMaxSections] = {};
+  OverflowCounter* events = nullptr;  // kBatchLanes counters: the section outputs' overflows
+};
+
+// Correlator bank: the layout's constants (CorrelatorFixedLayout) and every lane's state, in
+// arrays the owner allocates (sizes in the comments).
+struct BankBatch {
+  int period = 0, decimation = 0, taps = 0, chips = 0, codes = 0, step = 0;  // step = Nc / D
+  int mix_shift = 0, chip_shift = 0, corr_shift = 0;
+  FxRange mix_range{}, chip_range{}, corr_range{};
+  bool fir_narrow = false;    // taps and Bd fit int32
+  bool power_narrow = false;  // C_q fits int32
+  const std::int64_t* lo_cos = nullptr;    // period
+  const std::int64_t* lo_nsin = nullptr;   // period: -lo_sin (the mixer's imaginary product)
+  const std::int64_t* taps_rev = nullptr;  // taps, reversed
+  const std::int64_t* sign_mask = nullptr; // codes x chips: 0 for chip 1 (+1), -1 for chip 0
+  const std::int64_t* weights = nullptr;   // codes
+  std::size_t window = 0, bd_n = 0, f_n = 0;
+  // state
+  int phase = 0, dec_phase = 0;
+  std::size_t y_idx = 0, bd_idx = 0, f_idx = 0;
+  Lanes acc_re{}, acc_im{}, energy{};
+  Lanes* b_re = nullptr;  // period
+  Lanes* b_im = nullptr;
+  Lanes* y2h = nullptr;   // window
+  Lanes* bd_re = nullptr; // 2 bd_n (a ring stored twice)
+  Lanes* bd_im = nullptr;
+  Lanes* f_re = nullptr;  // 2 f_n
+  Lanes* f_im = nullptr;
+  Lanes* q = nullptr;     // codes: Q_j of the last decimated output
+  OverflowCounter* mix_events = nullptr;  // kBatchLanes counters each
+  OverflowCounter* chip_events = nullptr;
+  OverflowCounter* corr_events = nullptr;
+};
+
+// True when this build has the kernels and the CPU runs them.
+bool batch_kernels_available();
+
+// out[i] = the cascade of in[i] (input codes, in range: the caller checks) for i < n, per lane.
+void bandpass_batch(BandpassBatch& s, const Lanes* in, Lanes* out, std::size_t n);
+
+// Feeds y[0..] up to and including the sample that completes a decimated output (then computes
+// it: s.q and s.energy hold it, and *ready is set) or to n; returns how many were consumed.
+std::size_t bank_feed_batch(BankBatch& s, const Lanes* y, std::size_t n, bool* ready);
+
+}  // namespace ranging::batch

@@ -1,0 +1,267 @@
+// AVX-512 (x86-64-v4) kernels of ReceiverFixedBatch: see receiver_batch_kernels.hpp.
+//
+// Built with -march=x86-64-v4 when the compiler takes it (model/CMakeLists.txt); otherwise the
+// kernels are absent and batch_kernels_available() says so. Nothing here may be an inline
+// function shared with other translation units (they would carry AVX-512 code onto CPUs
+// without it): the helpers are in an anonymous namespace, the only outside call is
+// fx_overflow_slow (compiled for the baseline ISA in fixed_point.cpp).
+//
+// Word lengths and exactness: every lane computes what the scalar model computes on the same
+// int64 values, with the scalar model's bounds (BandpassFixed: |acc| < 2^63 by acc_bits <= 64;
+// CorrelatorBankFixed: the layout's widths <= 62 bits), so no lane overflows int64. A 32 x 32
+// -> 64 multiply (vpmuldq) is used only where the owner proved both factors fit int32
+// (BandpassBatch::narrow, BankBatch::fir_narrow / power_narrow); otherwise the full 64-bit
+// multiply (vpmullq), whose low 64 bits are the exact product under those bounds. Rounding is
+// fx_round_shift's, overflow fx_overflow_slow's (saturate or wrap, counted per lane).
+#include "model/dsp/receiver_batch_kernels.hpp"
+
+#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__)
+#include <immintrin.h>
+#define RANGING_BATCH_V4 1
+#endif
+
+namespace ranging::batch {
+
+#ifdef RANGING_BATCH_V4
+
+namespace {
+
+typedef std::int64_t V __attribute__((vector_size(64)));
+
+inline V load(const Lanes& l) { return *reinterpret_cast<const V*>(l.v); }
+inline void store(Lanes& l, V v) { *reinterpret_cast<V*>(l.v) = v; }
+inline V splat(std::int64_t x) { return V{} + x; }
+
+// Exact products: Narrow when both factors are known to fit int32 (vpmuldq), else vpmullq.
+template <bool Narrow>
+inline V mul(V a, V b) {
+  if constexpr (Narrow) {
+    // the zero-masked form: the plain one trips GCC 12's -Wmaybe-uninitialized in its header
+    return reinterpret_cast<V>(
+        _mm512_maskz_mul_epi32(__mmask8(0xFF), reinterpret_cast<__m512i>(a), reinterpret_cast<__m512i>(b)));
+  } else {
+    return a * b;
+  }
+}
+
+// fx_round_shift<R>(raw, shift) per lane: floor(raw / 2^shift) adjusted by R; shift 0: raw.
+template <Rounding R>
+inline V round_shift(V raw, int shift) {
+  if (shift == 0) return raw;
+  const V q = raw >> shift;  // arithmetic
+  if constexpr (R == Rounding::Truncate) {
+    return q;
+  } else if constexpr (R == Rounding::RoundHalfUp) {
+    return q + ((raw >> (shift - 1)) & 1);
+  } else {
+    const V rem = raw & splat(static_cast<std::int64_t>((std::uint64_t{1} << shift) - 1));
+    const V half = splat(static_cast<std::int64_t>(std::uint64_t{1} << (shift - 1)));
+    // comparisons give -1 (true) or 0 per lane; rem and half are non-negative
+    return q - ((rem > half) | ((rem == half) & ((q & 1) != 0)));
+  }
+}
+
+// Brings out-of-range lanes into r by o, counting each in its lane's counter.
+inline V overflow(V y, const FxRange& r, Overflow o, OverflowCounter* events) {
+  const __m512i yi = reinterpret_cast<__m512i>(y);
+  const __mmask8 bad = _mm512_cmplt_epi64_mask(yi, _mm512_set1_epi64(r.lo)) |
+                       _mm512_cmpgt_epi64_mask(yi, _mm512_set1_epi64(r.hi));
+  if (bad) [[unlikely]] {
+    for (int l = 0; l < kBatchLanes; ++l) {
+      if ((bad >> l) & 1) y[l] = fx_overflow_slow(y[l], r, o, events[l]);
+    }
+  }
+  return y;
+}
+
+template <int N, Rounding R, bool Narrow, bool Sym>
+void bandpass_kernel(BandpassBatch& s, const Lanes* in, Lanes* out, std::size_t n) {
+  V b0[N], b1[N], b2[N], a1[N], a2[N], y1[N], y2[N];
+  for (int k = 0; k < N; ++k) {
+    b0[k] = splat(s.coef[k][0]);
+    b1[k] = splat(s.coef[k][1]);
+    b2[k] = splat(s.coef[k][2]);
+    a1[k] = splat(s.coef[k][3]);
+    a2[k] = splat(s.coef[k][4]);
+    y1[k] = load(s.y1[k]);
+    y2[k] = load(s.y2[k]);
+  }
+  V in1 = load(s.x1), in2 = load(s.x2);
+  const int ish = s.input_shift, qs = s.qshift;
+  for (std::size_t i = 0; i < n; ++i) {
+    V x = load(in[i]) << ish;  // = code * 2^input_shift (two's complement, exact in range)
+    V x1 = in1, x2 = in2;
+    in2 = in1;
+    in1 = x;
+    for (int k = 0; k < N; ++k) {
+      V part;
+      if constexpr (Sym) {
+        part = mul<Narrow>(b0[k], x - x2) - mul<Narrow>(a2[k], y2[k]);
+      } else {
+        part = mul<Narrow>(b0[k], x) + mul<Narrow>(b1[k], x1) + mul<Narrow>(b2[k], x2) - mul<Narrow>(a2[k], y2[k]);
+      }
+      const V acc = part - mul<Narrow>(a1[k], y1[k]);
+      const V y = overflow(round_shift<R>(acc, qs), s.range, s.overflow, s.events);
+      x1 = y1[k];
+      x2 = y2[k];
+      y2[k] = y1[k];
+      y1[k] = y;
+      x = y;
+    }
+    store(out[i], x);
+  }
+  store(s.x1, in1);
+  store(s.x2, in2);
+  for (int k = 0; k < N; ++k) {
+    store(s.y1[k], y1[k]);
+    store(s.y2[k], y2[k]);
+  }
+}
+
+template <int N, Rounding R>
+void bandpass_forms(BandpassBatch& s, const Lanes* in, Lanes* out, std::size_t n) {
+  if (s.narrow) {
+    s.sym ? bandpass_kernel<N, R, true, true>(s, in, out, n) : bandpass_kernel<N, R, true, false>(s, in, out, n);
+  } else {
+    s.sym ? bandpass_kernel<N, R, false, true>(s, in, out, n) : bandpass_kernel<N, R, false, false>(s, in, out, n);
+  }
+}
+
+template <Rounding R>
+void bandpass_sections(BandpassBatch& s, const Lanes* in, Lanes* out, std::size_t n) {
+  switch (s.sections) {
+    case 1: return bandpass_forms<1, R>(s, in, out, n);
+    case 2: return bandpass_forms<2, R>(s, in, out, n);
+    case 3: return bandpass_forms<3, R>(s, in, out, n);
+    case 4: return bandpass_forms<4, R>(s, in, out, n);
+    case 5: return bandpass_forms<5, R>(s, in, out, n);
+    case 6: return bandpass_forms<6, R>(s, in, out, n);
+    case 7: return bandpass_forms<7, R>(s, in, out, n);
+    default: return bandpass_forms<8, R>(s, in, out, n);
+  }
+}
+
+// The bank's quantizers are all round half up and saturate (CorrelatorBankFixed).
+inline V quantize_rhu_sat(V raw, int shift, const FxRange& r, OverflowCounter* events) {
+  return overflow(round_shift<Rounding::RoundHalfUp>(raw, shift), r, Overflow::Saturate, events);
+}
+
+template <bool FirNarrow, bool PowerNarrow>
+void decimated_output(BankBatch& s) {
+  // decimator output: every D-th moving sum, into both copies of the Bd ring
+  if (++s.bd_idx == s.bd_n) s.bd_idx = 0;
+  s.bd_re[s.bd_idx] = s.bd_re[s.bd_idx + s.bd_n] = s.acc_re;
+  s.bd_im[s.bd_idx] = s.bd_im[s.bd_idx + s.bd_n] = s.acc_im;
+  // 3. chip filter: exact accumulation over the window Bd[k] .. Bd[k-M+1], then round half up
+  V fre{}, fim{};
+  const Lanes* bre = s.bd_re + s.bd_idx + 1;
+  const Lanes* bim = s.bd_im + s.bd_idx + 1;
+  for (std::size_t i = 0; i < s.bd_n; ++i) {
+    const V t = splat(s.taps_rev[i]);
+    fre += mul<FirNarrow>(t, load(bre[i]));
+    fim += mul<FirNarrow>(t, load(bim[i]));
+  }
+  if (++s.f_idx == s.f_n) s.f_idx = 0;
+  const V fq_re = quantize_rhu_sat(fre, s.chip_shift, s.chip_range, s.chip_events);
+  const V fq_im = quantize_rhu_sat(fim, s.chip_shift, s.chip_range, s.chip_events);
+  store(s.f_re[s.f_idx], fq_re);
+  store(s.f_re[s.f_idx + s.f_n], fq_re);
+  store(s.f_im[s.f_idx], fq_im);
+  store(s.f_im[s.f_idx + s.f_n], fq_im);
+  // 4-6. combiner (exact), quantize, power, weight. Chip c reads F[k - (L-1-c) Nc/D]; a -1
+  // chip subtracts: (g ^ m) - m is -g for m = -1 and g for m = 0.
+  const std::size_t chips = static_cast<std::size_t>(s.chips);
+  const std::size_t step = static_cast<std::size_t>(s.step);
+  const std::int64_t* sg = s.sign_mask;
+  for (int j = 0; j < s.codes; ++j, sg += chips) {
+    V cre{}, cim{};
+    for (std::size_t c = 0; c < chips; ++c) {
+      const std::size_t k = s.f_idx + s.f_n - (chips - 1 - c) * step;
+      const V m = splat(sg[c]);
+      cre += (load(s.f_re[k]) ^ m) - m;
+      cim += (load(s.f_im[k]) ^ m) - m;
+    }
+    const V cr = quantize_rhu_sat(cre, s.corr_shift, s.corr_range, s.corr_events);
+    const V ci = quantize_rhu_sat(cim, s.corr_shift, s.corr_range, s.corr_events);
+    const V p = mul<PowerNarrow>(cr, cr) + mul<PowerNarrow>(ci, ci);
+    store(s.q[j], p * splat(s.weights[j]));  // Q = P w: the layout proves it fits 64 bits
+  }
+}
+
+}  // namespace
+
+bool batch_kernels_available() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+         __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw");
+}
+
+void bandpass_batch(BandpassBatch& s, const Lanes* in, Lanes* out, std::size_t n) {
+  switch (s.rounding) {
+    case Rounding::Truncate: return bandpass_sections<Rounding::Truncate>(s, in, out, n);
+    case Rounding::RoundHalfUp: return bandpass_sections<Rounding::RoundHalfUp>(s, in, out, n);
+    default: return bandpass_sections<Rounding::Convergent>(s, in, out, n);
+  }
+}
+
+std::size_t bank_feed_batch(BankBatch& s, const Lanes* in, std::size_t n, bool* ready) {
+  // Exact int64 (CorrelatorBankFixed::feed's bounds): |y| < 2^31 and |lo| < 2^23 fit int32, so
+  // the mixer's and the energy's products are 32 x 32 -> 64.
+  const int mix_shift = s.mix_shift;
+  const int period = s.period, decimation = s.decimation;
+  const std::size_t window = s.window;
+  int phase = s.phase, dec_phase = s.dec_phase;
+  std::size_t y_idx = s.y_idx;
+  V acc_re = load(s.acc_re), acc_im = load(s.acc_im), energy = load(s.energy);
+  std::size_t i = 0;
+  *ready = false;
+  while (i < n) {
+    const V y = load(in[i++]);
+    // 1. mixer, round half up, saturate (counted)
+    const V mre = quantize_rhu_sat(mul<true>(y, splat(s.lo_cos[phase])), mix_shift, s.mix_range, s.mix_events);
+    const V mim = quantize_rhu_sat(mul<true>(y, splat(s.lo_nsin[phase])), mix_shift, s.mix_range, s.mix_events);
+    // 2. moving sum over one carrier cycle (exact)
+    acc_re += mre - load(s.b_re[phase]);
+    acc_im += mim - load(s.b_im[phase]);
+    store(s.b_re[phase], mre);
+    store(s.b_im[phase], mim);
+    if (++phase == period) phase = 0;
+    // 7. energy: running sum of y^2 over the window (uint64 arithmetic: the same bits)
+    if (++y_idx == window) y_idx = 0;
+    const V y2 = mul<true>(y, y);
+    energy = energy + y2 - load(s.y2h[y_idx]);
+    store(s.y2h[y_idx], y2);
+    if (++dec_phase == decimation) {
+      dec_phase = 0;
+      *ready = true;
+      break;
+    }
+  }
+  s.phase = phase;
+  s.dec_phase = dec_phase;
+  s.y_idx = y_idx;
+  store(s.acc_re, acc_re);
+  store(s.acc_im, acc_im);
+  store(s.energy, energy);
+  if (*ready) {
+    if (s.fir_narrow) {
+      s.power_narrow ? decimated_output<true, true>(s) : decimated_output<true, false>(s);
+    } else {
+      s.power_narrow ? decimated_output<false, true>(s) : decimated_output<false, false>(s);
+    }
+  }
+  return i;
+}
+
+#else  // no AVX-512 build: the kernels are absent
+
+bool batch_kernels_available() { return false; }
+void bandpass_batch(BandpassBatch&, const Lanes*, Lanes*, std::size_t) {}
+std::size_t bank_feed_batch(BankBatch&, const Lanes*, std::size_t, bool* ready) {
+  *ready = false;
+  return 0;
+}
+
+#endif
+
+}  // namespace ranging::batch
