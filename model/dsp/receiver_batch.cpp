@@ -172,6 +172,7 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
     open[l] = true;
     if (len[l] == 0) finish(l);
   }
+  const std::int64_t in_lo = fx_min_raw(k.filter.input_format()), in_hi = fx_max_raw(k.filter.input_format());
   constexpr std::size_t kChunk = 1024;
   k.in.resize(kChunk);
   k.out.resize(kChunk);
@@ -184,9 +185,16 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
     // interleave: lane l's sample n0 + i at in[i].v[l]; lanes past their end get zeros
     for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
       const std::size_t have = l < lanes && len[l] > n0 ? std::min(n, len[l] - n0) : 0;
-      if (have > 0) k.filter.check_input(streams[l].subspan(n0, have));
       const std::int64_t* src = have > 0 ? streams[l].data() + n0 : nullptr;
-      for (std::size_t i = 0; i < have; ++i) k.in[i].v[l] = src[i];
+      std::int64_t mn = 0, mx = 0;
+      for (std::size_t i = 0; i < have; ++i) {
+        const std::int64_t v = src[i];
+        k.in[i].v[l] = v;
+        mn = v < mn ? v : mn;
+        mx = v > mx ? v : mx;
+      }
+      // the input range, checked once per chunk; the scalar check names the sample
+      if (mn < in_lo || mx > in_hi) k.filter.check_input(streams[l].subspan(n0, have));
       for (std::size_t i = have; i < n; ++i) k.in[i].v[l] = 0;
     }
     batch::bandpass_batch(k.bp, k.in.data(), k.out.data(), n);

@@ -22,6 +22,7 @@
 #include "model/base/parallel.hpp"
 #include "model/dsp/excitation.hpp"
 #include "model/dsp/latency.hpp"
+#include "model/dsp/receiver_batch.hpp"
 #include "model/sim/metrics.hpp"
 
 namespace ranging {
@@ -308,10 +309,7 @@ struct SceneSimulator::Link {
     for (std::size_t n0 = 0; n0 < volts.size(); n0 += kChunk) {
       const std::size_t n1 = std::min(volts.size(), n0 + kChunk);
       std::int64_t* q = raw.data() + (observed ? n0 : 0);
-      for (std::size_t n = n0; n < n1; ++n) {
-        if (clamped && std::abs(volts[n] * inv) > 1.0) clamped->push_back(n);
-        q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
-      }
+      quantize_codes(volts, n0, n1, inv, q, adc, clamped);
       rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
       if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only
         bp.execute_block(std::span<const double>(volts.data() + n0, n1 - n0),
@@ -323,6 +321,55 @@ struct SceneSimulator::Link {
     if (observed) (*observer)(design, raw, raw_events);
     ovf += rx.overflow_events().total() + adc.total();
     return ev;
+  }
+
+  // The ADC codes of volts[n0, n1) / scale, as ReceiverFixed::execute(double) quantizes them,
+  // into q[0, n1 - n0); appends the indices the clamp to +-scale cut to *clamped.
+  void quantize_codes(const std::vector<double>& volts, std::size_t n0, std::size_t n1, double inv, std::int64_t* q,
+                      OverflowCounter& adc, std::vector<std::size_t>* clamped) const {
+    const int bits = design.config.bandpass.input_bits;
+    for (std::size_t n = n0; n < n1; ++n) {
+      if (clamped && std::abs(volts[n] * inv) > 1.0) clamped->push_back(n);
+      q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), bits, &adc);
+    }
+  }
+
+  // One stream of receive_batch: its input, and what receive() gives for it.
+  struct BatchStream {
+    const std::vector<double>* volts = nullptr;
+    std::vector<std::size_t>* clamped = nullptr;  // receive()'s clamped
+    std::vector<Event> events;
+    std::vector<double> filtered;
+    std::uint64_t overflows = 0;  // added to receive()'s *ovf
+  };
+  // receive() on several streams at the fixed precision (not observed): the streams run
+  // together through ReceiverFixedBatch (one per SIMD lane, bit for bit ReceiverFixed per
+  // stream: tests/test_receiver_batch.cpp), so every result is receive_fixed's.
+  void receive_batch(std::vector<BatchStream>& streams, double scale, ReceiverFixedBatch& batch) const {
+    const double inv = 1.0 / scale;
+    std::vector<std::vector<std::int64_t>> codes(streams.size());
+    std::vector<std::span<const std::int64_t>> spans;
+    std::vector<OverflowCounter> adc(streams.size());
+    for (std::size_t i = 0; i < streams.size(); ++i) {
+      const auto& v = *streams[i].volts;
+      codes[i].resize(v.size());
+      quantize_codes(v, 0, v.size(), inv, codes[i].data(), adc[i], streams[i].clamped);
+      spans.emplace_back(codes[i]);
+    }
+    std::vector<std::vector<EventFixed>> raw;
+    std::vector<OverflowCounter> ovf;
+    batch.run(spans, raw, ovf);
+    for (std::size_t i = 0; i < streams.size(); ++i) {
+      auto& st = streams[i];
+      st.filtered.assign(st.volts->size(), 0.0);
+      if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only
+        BandpassFloat bp(design.filter);
+        bp.execute_block(std::span<const double>(*st.volts), std::span<double>(st.filtered));
+      }
+      st.events.clear();
+      for (const auto& e : raw[i]) st.events.push_back(batch.to_float(e));
+      st.overflows = ovf[i].total() + adc[i].total();
+    }
   }
 
   // receive() over a capture read in blocks, events only (the filtered stream is not kept).
@@ -741,8 +788,18 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     std::vector<double> x;
   };
   const bool keep_x = static_cast<bool>(capture);
-  auto one = [&](const Item& it, PearsonBank& pb) {
+  // A stream in three steps: prepare (assemble it and its compensation reference, noise, ADC),
+  // receive (the receiver over both), finish (detections, compensation, matching). one() runs
+  // them on a stream; at the fixed precision, group() receives up to 8 streams together
+  // (ReceiverFixedBatch: one per SIMD lane), with the same results.
+  struct Prepared {
+    std::vector<double> x, xr;          // the stream and its compensation reference (if any)
+    std::vector<std::size_t> clipped;   // sample indices the input stage clipped
+    std::vector<Event> ev, rev;         // the receiver's events over x and xr
+    std::vector<double> f, fr;          // the float bandpass over x and xr (for the metrics)
     StreamOut out;
+  };
+  auto prepare = [&](const Item& it, Prepared& p) {
     StageClock clk;
     const double d = s.geometry.distances_m[it.di];
     const int rep = it.rep;
@@ -758,37 +815,46 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       shifts.push_back(sh);
       end = std::max(end, cb.start + sh + static_cast<long>(cb.y.size()));
     }
-    std::vector<double> x(static_cast<std::size_t>(std::max<long>(end, 0)) + lk.stream_tail(), 0.0);
-    for (std::size_t k = 0; k < train.size(); ++k) Link::add_into(x, lk.clean(train[k].code, d), shifts[k]);
-    std::vector<std::size_t> clipped;  // sample indices the input stage clipped
+    p.x.assign(static_cast<std::size_t>(std::max<long>(end, 0)) + lk.stream_tail(), 0.0);
+    for (std::size_t k = 0; k < train.size(); ++k) Link::add_into(p.x, lk.clean(train[k].code, d), shifts[k]);
     const double sigma = noise_sigma(train, d);
-    add_noise_and_adc(x, sigma, d, rep, train, 0, clipped);
-    out.t.channel += clk.lap();
-    std::vector<double> f;
-    const auto ev = lk.receive(x, lk.input_scale(), f, &out.ovf, s.noise.adc ? nullptr : &clipped);
-    out.samples += x.size();
-    out.t.receiver += clk.lap();
-    const auto dets = lk.detections(ev, f, 0.0, train, pb);
-    out.t.metrics += clk.lap();
+    add_noise_and_adc(p.x, sigma, d, rep, train, 0, p.clipped);
+    p.out.samples += p.x.size();
+    if (s.compensation) {  // the reference path measures c (SceneCompensation)
+      const Sparse& cb = lk.clean(train.front().code, s.compensation->reference_distance_m);
+      p.xr.assign(static_cast<std::size_t>(std::max<long>(cb.start + static_cast<long>(cb.y.size()), 0)) +
+                      lk.stream_tail(),
+                  0.0);
+      Link::add_into(p.xr, cb, 0);
+      std::vector<std::size_t> rclip;
+      add_noise_and_adc(p.xr, sigma, d, rep, train, 1, rclip);
+      p.out.samples += p.xr.size();
+    }
+    p.out.t.channel += clk.lap();
+  };
+  auto receive_one = [&](Prepared& p) {
+    StageClock clk;
+    p.ev = lk.receive(p.x, lk.input_scale(), p.f, &p.out.ovf, s.noise.adc ? nullptr : &p.clipped);
+    if (s.compensation) p.rev = lk.receive(p.xr, lk.input_scale(), p.fr, &p.out.ovf);
+    p.out.t.receiver += clk.lap();
+  };
+  auto finish = [&](const Item& it, Prepared& p, PearsonBank& pb) {
+    StreamOut& out = p.out;
+    StageClock clk;
+    const double d = s.geometry.distances_m[it.di];
+    const int rep = it.rep;
+    const auto& train = trains[it.ti];
+    const std::vector<double>& x = p.x;
+    const std::vector<double>& f = p.f;
+    std::vector<std::size_t>& clipped = p.clipped;
+    const auto dets = lk.detections(p.ev, f, 0.0, train, pb);
     // Compensation: the reference path measures c (SceneCompensation).
     double c_est = s.receiver_speed();
     bool ref_missed = false;
     if (s.compensation) {
       const double dref = s.compensation->reference_distance_m;
       const Burst rb{train.front().code, 0.0};
-      const Sparse& cb = lk.clean(rb.code, dref);
-      std::vector<double> xr(static_cast<std::size_t>(std::max<long>(cb.start + static_cast<long>(cb.y.size()), 0)) +
-                                 lk.stream_tail(),
-                             0.0);
-      Link::add_into(xr, cb, 0);
-      std::vector<std::size_t> rclip;
-      add_noise_and_adc(xr, sigma, d, rep, train, 1, rclip);
-      out.t.channel += clk.lap();
-      std::vector<double> fr;
-      const auto rev = lk.receive(xr, lk.input_scale(), fr, &out.ovf);
-      out.samples += xr.size();
-      out.t.receiver += clk.lap();
-      const auto rdets = lk.detections(rev, fr, 0.0, {rb}, pb);
+      const auto rdets = lk.detections(p.rev, p.fr, 0.0, {rb}, pb);
       const double rtruth = dref / lk.c() * s.fs;
       int rbest = -1;
       for (std::size_t i = 0; i < rdets.size(); ++i) {
@@ -847,9 +913,40 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       out.rows.push_back(m);
     }
     for (bool u : used) out.fa += !u;
-    out.t.metrics += clk.lap();  // the reference's metrics, the matching and the missed bursts' metrics
-    if (keep_x) out.x = std::move(x);
-    return out;
+    out.t.metrics += clk.lap();  // the detections' metrics, the matching and the missed bursts' metrics
+    if (keep_x) out.x = std::move(p.x);
+    return std::move(out);
+  };
+  auto one = [&](const Item& it, PearsonBank& pb) {
+    Prepared p;
+    prepare(it, p);
+    receive_one(p);
+    return finish(it, p, pb);
+  };
+  // Streams [b, e) of items (at most 8), received together at the fixed precision.
+  const bool batched = lk.fixed() && !observer_;
+  auto group = [&](std::size_t b, std::size_t e, PearsonBank& pb, ReceiverFixedBatch& rb, StreamOut* outs) {
+    std::vector<Prepared> ps(e - b);
+    for (std::size_t i = b; i < e; ++i) prepare(items[i], ps[i - b]);
+    StageClock clk;
+    for (int ref = 0; ref < (s.compensation ? 2 : 1); ++ref) {
+      std::vector<Link::BatchStream> bs(ps.size());
+      for (std::size_t i = 0; i < ps.size(); ++i) {
+        bs[i].volts = ref ? &ps[i].xr : &ps[i].x;
+        bs[i].clamped = !ref && !s.noise.adc ? &ps[i].clipped : nullptr;
+      }
+      lk.receive_batch(bs, lk.input_scale(), rb);
+      for (std::size_t i = 0; i < ps.size(); ++i) {
+        (ref ? ps[i].rev : ps[i].ev) = std::move(bs[i].events);
+        (ref ? ps[i].fr : ps[i].f) = std::move(bs[i].filtered);
+        ps[i].out.ovf += bs[i].overflows;
+      }
+    }
+    const double t = clk.lap() / static_cast<double>(ps.size());  // the group's receiver time, shared
+    for (std::size_t i = b; i < e; ++i) {
+      ps[i - b].out.t.receiver += t;
+      outs[i - b] = finish(items[i], ps[i - b], pb);
+    }
   };
 
   std::vector<Measurement> rows;
@@ -868,33 +965,54 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   };
   // The fixed-stream observer sees the streams in order: one thread then.
   const std::size_t jobs = (observer_ ? 1 : std::min<std::size_t>(static_cast<std::size_t>(std::max(jobs_, 1)), items.size()));
-  if (jobs <= 1) {
-    for (const auto& it : items) {
-      StreamOut o = one(it, *lk.bank);
-      emit(o, it);
-    }
-  } else {
-    // Batches of a few streams per worker; each worker has its own matched filter (PearsonBank
-    // owns FFTW buffers). Results are emitted in item order, so the output does not depend on jobs.
-    std::vector<std::unique_ptr<PearsonBank>> banks;
-    for (std::size_t k = 0; k < jobs; ++k) banks.push_back(std::make_unique<PearsonBank>(lk.templates));
-    const std::size_t batch = 4 * jobs;
-    for (std::size_t b0 = 0; b0 < items.size(); b0 += batch) {
-      const std::size_t b1 = std::min(items.size(), b0 + batch);
-      std::vector<StreamOut> outs(b1 - b0);
-      std::vector<std::exception_ptr> errors(b1 - b0);  // per stream: the first in stream order is thrown
-      parallel_items(b1 - b0, jobs, [&](std::size_t i, std::size_t t) {
-        try {
-          outs[i] = one(items[b0 + i], *banks[t]);
-        } catch (...) {
-          errors[i] = std::current_exception();
-        }
-      });
-      for (std::size_t i = b0; i < b1; ++i) {
-        // As with one thread: the streams before a failing one are emitted, then its error.
-        if (errors[i - b0]) std::rethrow_exception(errors[i - b0]);
-        emit(outs[i - b0], items[i]);
+  // Units of work: `per` consecutive streams (a group at the fixed precision, else one).
+  const std::size_t per = batched ? ReceiverFixedBatch::kLanes : 1;
+  auto run_unit = [&](std::size_t b, std::size_t e, PearsonBank& pb, ReceiverFixedBatch* rb, StreamOut* outs,
+                      std::exception_ptr* errors) {
+    if (rb) {
+      try {
+        group(b, e, pb, *rb, outs);
+        return;
+      } catch (...) {
+        // a stream of the group failed: run them one at a time, so each has its own outcome
       }
+    }
+    for (std::size_t i = b; i < e; ++i) {
+      try {
+        outs[i - b] = one(items[i], pb);
+      } catch (...) {
+        errors[i - b] = std::current_exception();
+      }
+    }
+  };
+  // Each worker has its own matched filter (PearsonBank owns FFTW buffers) and batch receiver.
+  // Results are emitted in item order, so the output depends neither on jobs nor on grouping.
+  std::vector<std::unique_ptr<PearsonBank>> banks;
+  std::vector<std::unique_ptr<ReceiverFixedBatch>> rbs;
+  for (std::size_t k = 0; k < jobs; ++k) {
+    banks.push_back(k == 0 ? nullptr : std::make_unique<PearsonBank>(lk.templates));
+    if (batched) rbs.push_back(std::make_unique<ReceiverFixedBatch>(lk.design));
+  }
+  const std::size_t round = per * (jobs <= 1 ? 1 : 4 * jobs);
+  for (std::size_t b0 = 0; b0 < items.size(); b0 += round) {
+    const std::size_t b1 = std::min(items.size(), b0 + round);
+    std::vector<StreamOut> outs(b1 - b0);
+    std::vector<std::exception_ptr> errors(b1 - b0);  // per stream: the first in stream order is thrown
+    const std::size_t units = (b1 - b0 + per - 1) / per;
+    auto unit = [&](std::size_t u, std::size_t t) {
+      const std::size_t b = b0 + u * per, e = std::min(b1, b + per);
+      run_unit(b, e, t == 0 ? *lk.bank : *banks[t], batched ? rbs[t].get() : nullptr, outs.data() + (b - b0),
+               errors.data() + (b - b0));
+    };
+    if (jobs <= 1) {
+      for (std::size_t u = 0; u < units; ++u) unit(u, 0);
+    } else {
+      parallel_items(units, jobs, unit);
+    }
+    for (std::size_t i = b0; i < b1; ++i) {
+      // As with one thread: the streams before a failing one are emitted, then its error.
+      if (errors[i - b0]) std::rethrow_exception(errors[i - b0]);
+      emit(outs[i - b0], items[i]);
     }
   }
   if (false_alarms) *false_alarms = fa;
