@@ -41,9 +41,15 @@ struct RunResult {
   std::size_t ticks = 0;
 };
 
-RunResult run_all(const std::string& yaml, int jobs) {
+// observed: a fixed-stream observer is set, so every stream runs alone through ReceiverFixed
+// (otherwise the fixed precision receives 8 streams at once through ReceiverFixedBatch).
+RunResult run_all(const std::string& yaml, int jobs, std::size_t* observed = nullptr) {
   SceneSimulator sim(parse_scene(yaml, "s.yaml"));
   sim.set_jobs(jobs);
+  if (observed) {
+    sim.set_fixed_observer([observed](const ReceiverDesign&, const std::vector<std::int64_t>&,
+                                      const std::vector<EventFixed>&) { ++*observed; });
+  }
   RunResult r;
   for (const auto& f : sim.scene().excitation.families) {
     std::size_t fa = 0;
@@ -109,6 +115,20 @@ TEST(ParallelStreams, FixedSingleModeIsIdenticalWithOneAndThreeThreads) {
   for (auto v : one.overflows) ovf += v;
   EXPECT_GT(ovf, 0u) << "the receiver input at 0.3 V full scale should saturate at 0.1 m: overflow counts are compared";
   expect_same(one, run_all(y, 3));
+}
+
+// The fixed precision's groups of streams (ReceiverFixedBatch) against one stream at a time
+// (ReceiverFixed): the same measurements, overflow counts and captures, single and periodic.
+TEST(ParallelStreams, FixedGroupsOfStreamsMatchTheReceiverOneStreamAtATime) {
+  for (bool periodic : {false, true}) {
+    const std::string y = scene_yaml("fixed", periodic);
+    std::size_t observed = 0;
+    const RunResult alone = run_all(y, 1, &observed);
+    EXPECT_GE(observed, alone.ticks) << "every stream (and each calibration) went through the observed receiver";
+    ASSERT_GT(alone.ticks, 8u) << "more streams than one group";
+    expect_same(alone, run_all(y, 1));
+    expect_same(alone, run_all(y, 2));
+  }
 }
 
 TEST(ParallelStreams, FloatPeriodicIsIdenticalWithOneAndTwoThreads) {
