@@ -116,7 +116,6 @@ struct ReceiverFixedBatch::Kernels {
 ReceiverFixedBatch::ReceiverFixedBatch(const ReceiverDesign& design)
     : design_(design), frac_bits_(design.config.detector.frac_bits), score_bits_(design.config.correlator.score_bits) {
   vectorized_ = batch::batch_kernels_available() &&
-                design.config.bandpass.data_bits > 0 &&
                 static_cast<int>(design.filter.sections.size()) <= batch::kBatchMaxSections;
   if (vectorized_) k_ = std::make_unique<Kernels>(design_);
 }
