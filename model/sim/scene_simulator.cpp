@@ -993,7 +993,9 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     banks.push_back(k == 0 ? nullptr : std::make_unique<PearsonBank>(lk.templates));
     if (batched) rbs.push_back(std::make_unique<ReceiverFixedBatch>(lk.design));
   }
-  const std::size_t round = per * (jobs <= 1 ? 1 : 4 * jobs);
+  // Streams per round (the results of a round are held, then emitted in order): a few dozen
+  // units per thread, so that streams of different lengths balance between the threads.
+  const std::size_t round = jobs <= 1 ? per : (batched ? 8 * per : 32) * jobs;
   for (std::size_t b0 = 0; b0 < items.size(); b0 += round) {
     const std::size_t b1 = std::min(items.size(), b0 + round);
     std::vector<StreamOut> outs(b1 - b0);
