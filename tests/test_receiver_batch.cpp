@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <span>
 #include <vector>
@@ -148,4 +149,53 @@ TEST(ReceiverBatch, RefusesAnOutOfRangeCodeAsTheScalarReceiverDoes) {
   ReceiverFixed rx(d);
   std::vector<EventFixed> ev;
   EXPECT_THROW(rx.execute_block(streams[1], ev), InputError);
+}
+
+// ReceiverFloatBatch against ReceiverFloat per stream: the same events and every filtered
+// sample, bit for bit (memcmp of the doubles), with the input gain applied the same way.
+TEST(ReceiverBatch, FloatMatchesTheScalarReceiverPerStreamBitForBit) {
+  for (const char* family : {"Gold4", "M3"}) {
+    ReceiverConfig cfg;
+    cfg.family = family;
+    fit_decimation_to_chip(cfg);
+    const ReceiverDesign d = design_receiver(cfg);
+    const int dec = d.layout.decimation;
+    const std::vector<std::size_t> lengths = {30011, 24000, 9000, 0, 1, static_cast<std::size_t>(dec - 1),
+                                              static_cast<std::size_t>(dec), static_cast<std::size_t>(dec + 1),
+                                              17777, 30011, 5003};
+    // volts: the codes' streams as doubles at an arbitrary scale, so the gain's rounding matters
+    std::vector<std::vector<double>> volts;
+    for (const auto& q : make_streams(d, lengths, 13)) {
+      std::vector<double> v;
+      for (auto c : q) v.push_back(0.037 * static_cast<double>(c) + 1e-7 * static_cast<double>(v.size() % 7));
+      volts.push_back(std::move(v));
+    }
+    const double gain = 1.0 / (0.037 * 2048.0);
+    std::vector<std::span<const double>> spans(volts.begin(), volts.end());
+    ReceiverFloatBatch batch(d);
+    std::vector<std::vector<Event>> events;
+    std::vector<std::vector<double>> filtered;
+    batch.run(spans, gain, events, &filtered);
+    std::size_t detected = 0;
+    for (std::size_t s = 0; s < volts.size(); ++s) {
+      ReceiverFloat rx(d);
+      std::vector<double> x(volts[s].size()), f(volts[s].size());
+      for (std::size_t i = 0; i < x.size(); ++i) x[i] = volts[s][i] * gain;
+      std::vector<Event> want;
+      rx.execute_block(x, want, f);
+      if (auto e = rx.flush()) want.push_back(*e);
+      ASSERT_EQ(events[s].size(), want.size()) << family << " stream " << s;
+      for (std::size_t i = 0; i < want.size(); ++i) {
+        EXPECT_EQ(events[s][i].code, want[i].code);
+        EXPECT_EQ(std::memcmp(&events[s][i].arrival, &want[i].arrival, sizeof(double)), 0) << family << " " << s;
+        EXPECT_EQ(std::memcmp(&events[s][i].score, &want[i].score, sizeof(double)), 0) << family << " " << s;
+        EXPECT_EQ(std::memcmp(&events[s][i].margin, &want[i].margin, sizeof(double)), 0) << family << " " << s;
+      }
+      ASSERT_EQ(filtered[s].size(), f.size());
+      EXPECT_EQ(std::memcmp(filtered[s].data(), f.data(), f.size() * sizeof(double)), 0) << family << " stream " << s;
+      detected += want.size();
+    }
+    EXPECT_GT(detected, volts.size()) << family;
+    std::printf("[ receiver batch ] float %s: %s path\n", family, batch.vectorized() ? "AVX-512" : "scalar");
+  }
 }

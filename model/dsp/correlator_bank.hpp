@@ -111,6 +111,9 @@ class CorrelatorBankFloat {
   std::int64_t sample_index() const { return n_ - 1; }  // full-rate index of the last input
   int codes() const { return static_cast<int>(q_.size()); }
   const CorrelatorReference& reference() const { return ref_; }
+  // The LO tables cos / sin(2 pi p / P), p < P (ReceiverFloatBatch mixes with the very values).
+  const std::vector<double>& lo_cos() const { return lo_cos_; }
+  const std::vector<double>& lo_sin() const { return lo_sin_; }
 
  private:
   CorrelatorReference ref_;

@@ -102,20 +102,22 @@ Event PeakDetectorFloat::make_event(const Candidate& c) const {
 }
 
 std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank) {
-  const std::vector<double>& q = bank.weighted_power();
+  return execute(bank.weighted_power(), bank.sample_index(), bank.energy());
+}
+
+std::optional<Event> PeakDetectorFloat::execute(std::span<const double> q, std::int64_t n, double energy) {
   if (prev_.empty()) prev_.assign(q.size(), 0.0);
   int best;
   double second;
-  best_two(std::span<const double>(q), best, second);
-  take_right_neighbour(cand_, std::span<const double>(q));
-  const std::int64_t n = bank.sample_index();
-  const double rho2 = bank.rho2(best);
-  const bool gate = rho2 >= cfg_.threshold && bank.energy() >= cfg_.min_energy;
-  const double margin = rho2 - (bank.energy() > 0 ? second / bank.energy() : 0.0);
+  best_two(q, best, second);
+  take_right_neighbour(cand_, q);
+  const double rho2 = energy > 0 ? q[static_cast<std::size_t>(best)] / energy : 0.0;  // CorrelatorBankFloat::rho2
+  const bool gate = rho2 >= cfg_.threshold && energy >= cfg_.min_energy;
+  const double margin = rho2 - (energy > 0 ? second / energy : 0.0);
   auto out = next_candidate(cand_, gate && (!cand_ || rho2 > cand_->score),
                             Candidate{n, best, prev_[best], q[best], 0.0, rho2, margin, false}, n, holdoff_,
                             [this](const Candidate& c) { return make_event(c); });
-  prev_ = q;
+  prev_.assign(q.begin(), q.end());
   return out;
 }
 

@@ -70,6 +70,8 @@ class PeakDetectorFloat {
   }
   // Call after every bank.execute() that returned true.
   std::optional<Event> execute(const CorrelatorBankFloat& bank);
+  // The same from a decimated output's values: Q_j per code, the full-rate sample index, E.
+  std::optional<Event> execute(std::span<const double> q, std::int64_t n, double energy);
   std::optional<Event> flush();  // end of stream: emit a pending candidate
 
  private:

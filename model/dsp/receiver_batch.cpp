@@ -218,4 +218,169 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
   }
 }
 
+// ---- float -----------------------------------------------------------------------------
+
+using batch::LanesF;
+
+struct ReceiverFloatBatch::Kernels {
+  batch::FloatBandpassBatch bp;
+  batch::FloatBankBatch bank;
+  CorrelatorBankFloat scalar;  // the LO tables come from it
+  std::vector<double> taps, signs, gain;
+  std::vector<LanesF> b_re, b_im, y2h, bd_re, bd_im, f_re, f_im, q;
+  std::vector<LanesF> in, out;
+
+  explicit Kernels(const ReceiverDesign& d) : scalar(d.reference) {
+    const auto& sec = d.filter.sections;
+    bp.sections = static_cast<int>(sec.size());
+    for (std::size_t k = 0; k < sec.size(); ++k) {
+      const Biquad& c = sec[k];
+      const double v[5] = {c.b0, c.b1, c.b2, c.a1, c.a2};
+      for (int i = 0; i < 5; ++i) bp.coef[k][i] = v[i];
+    }
+    const CorrelatorReference& r = d.reference;
+    auto& b = bank;
+    b.period = r.period;
+    b.decimation = r.decimation;
+    b.chips = static_cast<int>(r.codes.front().size());
+    b.codes = static_cast<int>(r.codes.size());
+    b.step = r.chip_samples / r.decimation;
+    b.window = static_cast<std::size_t>(r.window);
+    b.bd_n = r.chip_taps.size();
+    b.f_n = static_cast<std::size_t>(b.chips - 1) * static_cast<std::size_t>(b.step) + 1;
+    taps = r.chip_taps;
+    for (const auto& code : r.codes) {
+      for (std::uint8_t chip : code) signs.push_back(chip ? 1.0 : -1.0);
+    }
+    gain = r.code_gain;
+    b.lo_cos = scalar.lo_cos().data();
+    b.lo_sin = scalar.lo_sin().data();
+    b.taps = taps.data();
+    b.signs = signs.data();
+    b.gain = gain.data();
+  }
+
+  void reset() {
+    auto& b = bank;
+    for (int k = 0; k < batch::kBatchMaxSections; ++k) bp.x1[k] = bp.x2[k] = bp.y1[k] = bp.y2[k] = LanesF{};
+    b_re.assign(static_cast<std::size_t>(b.period), LanesF{});
+    b_im.assign(b_re.size(), LanesF{});
+    y2h.assign(b.window, LanesF{});
+    bd_re.assign(2 * b.bd_n, LanesF{});
+    bd_im.assign(2 * b.bd_n, LanesF{});
+    f_re.assign(2 * b.f_n, LanesF{});
+    f_im.assign(2 * b.f_n, LanesF{});
+    q.assign(static_cast<std::size_t>(b.codes), LanesF{});
+    b.b_re = b_re.data();
+    b.b_im = b_im.data();
+    b.y2h = y2h.data();
+    b.bd_re = bd_re.data();
+    b.bd_im = bd_im.data();
+    b.f_re = f_re.data();
+    b.f_im = f_im.data();
+    b.q = q.data();
+    // CorrelatorBankFloat::reset's positions
+    b.b_idx = 0;
+    b.dec_phase = 0;
+    b.y_idx = b.window - 1;
+    b.bd_idx = b.bd_n - 1;
+    b.f_idx = b.f_n - 1;
+    b.acc_re = b.acc_im = b.energy = LanesF{};
+  }
+};
+
+ReceiverFloatBatch::ReceiverFloatBatch(const ReceiverDesign& design) : design_(design) {
+  vectorized_ = batch::batch_kernels_available() && !design.reference.codes.empty() &&
+                static_cast<int>(design.filter.sections.size()) <= batch::kBatchMaxSections;
+  if (vectorized_) k_ = std::make_unique<Kernels>(design_);
+}
+
+ReceiverFloatBatch::~ReceiverFloatBatch() = default;
+
+void ReceiverFloatBatch::run(std::span<const std::span<const double>> streams, double gain,
+                             std::vector<std::vector<Event>>& events, std::vector<std::vector<double>>* filtered) {
+  events.assign(streams.size(), {});
+  if (filtered) {
+    filtered->resize(streams.size());
+    for (std::size_t s = 0; s < streams.size(); ++s) (*filtered)[s].assign(streams[s].size(), 0.0);
+  }
+  for (std::size_t s0 = 0; s0 < streams.size(); s0 += kLanes) {
+    const std::size_t n = std::min(kLanes, streams.size() - s0);
+    if (!vectorized_) {
+      for (std::size_t s = s0; s < s0 + n; ++s) {
+        ReceiverFloat rx(design_);
+        std::vector<double> x(streams[s].size());
+        for (std::size_t i = 0; i < x.size(); ++i) x[i] = streams[s][i] * gain;
+        rx.execute_block(x, events[s], filtered ? std::span<double>((*filtered)[s]) : std::span<double>());
+        if (auto e = rx.flush()) events[s].push_back(*e);
+      }
+      continue;
+    }
+    run_lanes(streams.subspan(s0, n), gain, events.data() + s0, filtered ? filtered->data() + s0 : nullptr);
+  }
+}
+
+void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> streams, double gain,
+                                   std::vector<Event>* events, std::vector<double>* filtered) {
+  Kernels& k = *k_;
+  k.reset();
+  const std::size_t lanes = streams.size();
+  std::size_t len[kBatchLanes] = {}, longest = 0;
+  for (std::size_t l = 0; l < lanes; ++l) {
+    len[l] = streams[l].size();
+    longest = std::max(longest, len[l]);
+  }
+  std::vector<PeakDetectorFloat> det(lanes, PeakDetectorFloat(design_.config.detector, design_.reference));
+  const std::size_t codes = static_cast<std::size_t>(k.bank.codes);
+  std::vector<double> qv(codes);
+  bool open[kBatchLanes] = {};
+  for (std::size_t l = 0; l < lanes; ++l) open[l] = true;
+  auto finish = [&](std::size_t l) {
+    if (auto e = det[l].flush()) events[l].push_back(*e);
+    open[l] = false;
+  };
+  for (std::size_t l = 0; l < lanes; ++l) {
+    if (len[l] == 0) finish(l);
+  }
+  constexpr std::size_t kChunk = 1024;
+  k.in.resize(kChunk);
+  k.out.resize(kChunk);
+  for (std::size_t n0 = 0, n = 0; n0 < longest; n0 += n) {
+    // A chunk ends at the next lane's end (its detector is flushed after its last sample).
+    n = std::min(kChunk, longest - n0);
+    for (std::size_t l = 0; l < lanes; ++l) {
+      if (len[l] > n0) n = std::min(n, len[l] - n0);
+    }
+    for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
+      const std::size_t have = l < lanes && len[l] > n0 ? std::min(n, len[l] - n0) : 0;
+      const double* src = have > 0 ? streams[l].data() + n0 : nullptr;
+      for (std::size_t i = 0; i < have; ++i) k.in[i].v[l] = src[i] * gain;
+      for (std::size_t i = have; i < n; ++i) k.in[i].v[l] = 0.0;
+    }
+    batch::bandpass_batch_float(k.bp, k.in.data(), k.out.data(), n);
+    if (filtered) {
+      for (std::size_t l = 0; l < lanes; ++l) {
+        if (!open[l]) continue;
+        double* dst = filtered[l].data() + n0;
+        for (std::size_t i = 0; i < n; ++i) dst[i] = k.out[i].v[l];
+      }
+    }
+    std::size_t i = 0;
+    while (i < n) {
+      bool ready = false;
+      i += batch::bank_feed_batch_float(k.bank, k.out.data() + i, n - i, &ready);
+      if (!ready) continue;
+      const std::int64_t last = static_cast<std::int64_t>(n0 + i - 1);
+      for (std::size_t l = 0; l < lanes; ++l) {
+        if (!open[l]) continue;
+        for (std::size_t j = 0; j < codes; ++j) qv[j] = k.q[j].v[l];
+        if (auto e = det[l].execute(qv, last, k.bank.energy.v[l])) events[l].push_back(*e);
+      }
+    }
+    for (std::size_t l = 0; l < lanes; ++l) {
+      if (open[l] && len[l] == n0 + n) finish(l);
+    }
+  }
+}
+
 }  // namespace ranging

@@ -51,4 +51,35 @@ class ReceiverFixedBatch {
                  OverflowCounter* overflows);
 };
 
+// ReceiverFloatBatch: ReceiverFloat on up to kLanes streams at once, the same way (IEEE double
+// per lane in ReceiverFloat's order of operations, so each stream's events and filtered
+// samples are ReceiverFloat's bit for bit; the scalar receiver per stream where the kernels
+// cannot run).
+class ReceiverFloatBatch {
+ public:
+  static constexpr std::size_t kLanes = 8;
+
+  explicit ReceiverFloatBatch(const ReceiverDesign& design);
+  ~ReceiverFloatBatch();
+  ReceiverFloatBatch(const ReceiverFloatBatch&) = delete;
+  ReceiverFloatBatch& operator=(const ReceiverFloatBatch&) = delete;
+
+  // Runs every stream from reset on x = stream[i] * gain (full-scale units; the product is
+  // formed here, as a caller scaling a copy would). events[s] receives what
+  // ReceiverFloat::execute_block then flush give; filtered, when not null, every bandpass
+  // output of every stream (execute_block's `filtered`).
+  void run(std::span<const std::span<const double>> streams, double gain, std::vector<std::vector<Event>>& events,
+           std::vector<std::vector<double>>* filtered = nullptr);
+
+  bool vectorized() const { return vectorized_; }
+
+ private:
+  struct Kernels;
+  ReceiverDesign design_;
+  bool vectorized_ = false;
+  std::unique_ptr<Kernels> k_;
+  void run_lanes(std::span<const std::span<const double>> streams, double gain, std::vector<Event>* events,
+                 std::vector<double>* filtered);
+};
+
 }  // namespace ranging

@@ -72,6 +72,47 @@ struct BankBatch {
   OverflowCounter* corr_events = nullptr;
 };
 
+// ---- the float receiver (ReceiverFloatBatch): the same structure in double ----------------
+// IEEE double operations per lane in the scalar model's order (BandpassFloat's expression left
+// to right, CorrelatorBankFloat::feed / decimated_output), compiled without contraction
+// (-ffp-contract=off: no fused multiply-add the scalar build does not do), so every lane is the
+// scalar stream's doubles bit for bit.
+struct alignas(64) LanesF {
+  double v[kBatchLanes];
+};
+
+struct FloatBandpassBatch {
+  int sections = 0;
+  double coef[kBatchMaxSections][5] = {};  // {b0, b1, b2, a1, a2}
+  LanesF x1[kBatchMaxSections] = {}, x2[kBatchMaxSections] = {};
+  LanesF y1[kBatchMaxSections] = {}, y2[kBatchMaxSections] = {};
+};
+
+struct FloatBankBatch {
+  int period = 0, decimation = 0, chips = 0, codes = 0, step = 0;
+  std::size_t window = 0, bd_n = 0, f_n = 0;
+  const double* lo_cos = nullptr;  // period (CorrelatorBankFloat's tables)
+  const double* lo_sin = nullptr;
+  const double* taps = nullptr;    // bd_n chip taps g[i]
+  const double* signs = nullptr;   // codes x chips: +1.0 or -1.0
+  const double* gain = nullptr;    // codes: K_j
+  // state
+  std::size_t b_idx = 0, y_idx = 0, bd_idx = 0, f_idx = 0;
+  int dec_phase = 0;
+  LanesF acc_re{}, acc_im{}, energy{};
+  LanesF* b_re = nullptr;  // period
+  LanesF* b_im = nullptr;
+  LanesF* y2h = nullptr;   // window
+  LanesF* bd_re = nullptr; // 2 bd_n
+  LanesF* bd_im = nullptr;
+  LanesF* f_re = nullptr;  // 2 f_n
+  LanesF* f_im = nullptr;
+  LanesF* q = nullptr;     // codes
+};
+
+void bandpass_batch_float(FloatBandpassBatch& s, const LanesF* in, LanesF* out, std::size_t n);
+std::size_t bank_feed_batch_float(FloatBankBatch& s, const LanesF* in, std::size_t n, bool* ready);
+
 // True when this build has the kernels and the CPU runs them.
 bool batch_kernels_available();
 

@@ -188,7 +188,133 @@ void decimated_output(BankBatch& s) {
   }
 }
 
+// ---- float ----------------------------------------------------------------------------------
+
+typedef double D __attribute__((vector_size(64)));
+
+inline D loadf(const LanesF& l) { return *reinterpret_cast<const D*>(l.v); }
+inline void storef(LanesF& l, D v) { *reinterpret_cast<D*>(l.v) = v; }
+inline D splatf(double x) { return D{} + x; }
+
+template <int N>
+void bandpass_kernel_float(FloatBandpassBatch& s, const LanesF* in, LanesF* out, std::size_t n) {
+  D b0[N], b1[N], b2[N], a1[N], a2[N], x1[N], x2[N], y1[N], y2[N];
+  for (int k = 0; k < N; ++k) {
+    b0[k] = splatf(s.coef[k][0]);
+    b1[k] = splatf(s.coef[k][1]);
+    b2[k] = splatf(s.coef[k][2]);
+    a1[k] = splatf(s.coef[k][3]);
+    a2[k] = splatf(s.coef[k][4]);
+    x1[k] = loadf(s.x1[k]);
+    x2[k] = loadf(s.x2[k]);
+    y1[k] = loadf(s.y1[k]);
+    y2[k] = loadf(s.y2[k]);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    D x = loadf(in[i]);
+    for (int k = 0; k < N; ++k) {
+      // BandpassFloat::execute's expression, left to right
+      const D y = b0[k] * x + b1[k] * x1[k] + b2[k] * x2[k] - a1[k] * y1[k] - a2[k] * y2[k];
+      x2[k] = x1[k];
+      x1[k] = x;
+      y2[k] = y1[k];
+      y1[k] = y;
+      x = y;
+    }
+    storef(out[i], x);
+  }
+  for (int k = 0; k < N; ++k) {
+    storef(s.x1[k], x1[k]);
+    storef(s.x2[k], x2[k]);
+    storef(s.y1[k], y1[k]);
+    storef(s.y2[k], y2[k]);
+  }
+}
+
+void decimated_output_float(FloatBankBatch& s) {
+  if (++s.bd_idx == s.bd_n) s.bd_idx = 0;
+  s.bd_re[s.bd_idx] = s.bd_re[s.bd_idx + s.bd_n] = s.acc_re;
+  s.bd_im[s.bd_idx] = s.bd_im[s.bd_idx + s.bd_n] = s.acc_im;
+  D fre{}, fim{};
+  const std::size_t m = s.bd_n;
+  const LanesF* bre_h = s.bd_re + s.bd_idx + m;  // Bd[k - i] = bre_h[-i]
+  const LanesF* bim_h = s.bd_im + s.bd_idx + m;
+  for (std::size_t i = 0; i < m; ++i) {
+    const D t = splatf(s.taps[i]);
+    fre += t * loadf(*(bre_h - i));
+    fim += t * loadf(*(bim_h - i));
+  }
+  if (++s.f_idx == s.f_n) s.f_idx = 0;
+  storef(s.f_re[s.f_idx], fre);
+  storef(s.f_re[s.f_idx + s.f_n], fre);
+  storef(s.f_im[s.f_idx], fim);
+  storef(s.f_im[s.f_idx + s.f_n], fim);
+  const std::size_t chips = static_cast<std::size_t>(s.chips);
+  const std::size_t step = static_cast<std::size_t>(s.step);
+  const double* sg = s.signs;
+  for (int j = 0; j < s.codes; ++j, sg += chips) {
+    D cre{}, cim{};
+    for (std::size_t c = 0; c < chips; ++c) {
+      const std::size_t k = s.f_idx + s.f_n - (chips - 1 - c) * step;
+      const D sv = splatf(sg[c]);
+      cre += sv * loadf(s.f_re[k]);
+      cim += sv * loadf(s.f_im[k]);
+    }
+    storef(s.q[j], (cre * cre + cim * cim) / splatf(s.gain[j]));
+  }
+}
+
 }  // namespace
+
+void bandpass_batch_float(FloatBandpassBatch& s, const LanesF* in, LanesF* out, std::size_t n) {
+  switch (s.sections) {
+    case 1: return bandpass_kernel_float<1>(s, in, out, n);
+    case 2: return bandpass_kernel_float<2>(s, in, out, n);
+    case 3: return bandpass_kernel_float<3>(s, in, out, n);
+    case 4: return bandpass_kernel_float<4>(s, in, out, n);
+    case 5: return bandpass_kernel_float<5>(s, in, out, n);
+    case 6: return bandpass_kernel_float<6>(s, in, out, n);
+    case 7: return bandpass_kernel_float<7>(s, in, out, n);
+    default: return bandpass_kernel_float<8>(s, in, out, n);
+  }
+}
+
+std::size_t bank_feed_batch_float(FloatBankBatch& s, const LanesF* in, std::size_t n, bool* ready) {
+  const std::size_t period = static_cast<std::size_t>(s.period), window = s.window;
+  const int decimation = s.decimation;
+  std::size_t b_idx = s.b_idx, y_idx = s.y_idx;
+  int dec_phase = s.dec_phase;
+  D acc_re = loadf(s.acc_re), acc_im = loadf(s.acc_im), energy = loadf(s.energy);
+  const D zero{};
+  std::size_t i = 0;
+  *ready = false;
+  while (i < n) {
+    const D y = loadf(in[i++]);
+    const D bre = y * splatf(s.lo_cos[b_idx]), bim = -y * splatf(s.lo_sin[b_idx]);
+    acc_re += bre - loadf(s.b_re[b_idx]);
+    acc_im += bim - loadf(s.b_im[b_idx]);
+    storef(s.b_re[b_idx], bre);
+    storef(s.b_im[b_idx], bim);
+    if (++b_idx == period) b_idx = 0;
+    if (++y_idx == window) y_idx = 0;
+    energy += y * y - loadf(s.y2h[y_idx]);
+    storef(s.y2h[y_idx], y * y);
+    energy = energy < zero ? zero : energy;  // std::max(energy, 0.0)
+    if (++dec_phase == decimation) {
+      dec_phase = 0;
+      *ready = true;
+      break;
+    }
+  }
+  s.b_idx = b_idx;
+  s.y_idx = y_idx;
+  s.dec_phase = dec_phase;
+  storef(s.acc_re, acc_re);
+  storef(s.acc_im, acc_im);
+  storef(s.energy, energy);
+  if (*ready) decimated_output_float(s);
+  return i;
+}
 
 bool batch_kernels_available() {
   __builtin_cpu_init();
@@ -254,6 +380,12 @@ std::size_t bank_feed_batch(BankBatch& s, const Lanes* in, std::size_t n, bool* 
 }
 
 #else  // no AVX-512 build: the kernels are absent
+
+void bandpass_batch_float(FloatBandpassBatch&, const LanesF*, LanesF*, std::size_t) {}
+std::size_t bank_feed_batch_float(FloatBankBatch&, const LanesF*, std::size_t, bool* ready) {
+  *ready = false;
+  return 0;
+}
 
 bool batch_kernels_available() { return false; }
 void bandpass_batch(BandpassBatch&, const Lanes*, Lanes*, std::size_t) {}
