@@ -342,11 +342,37 @@ struct SceneSimulator::Link {
     std::vector<double> filtered;
     std::uint64_t overflows = 0;  // added to receive()'s *ovf
   };
-  // receive() on several streams at the fixed precision (not observed): the streams run
-  // together through ReceiverFixedBatch (one per SIMD lane, bit for bit ReceiverFixed per
-  // stream: tests/test_receiver_batch.cpp), so every result is receive_fixed's.
-  void receive_batch(std::vector<BatchStream>& streams, double scale, ReceiverFixedBatch& batch) const {
+  // Both batch receivers of a worker (the one of the scene's precision is used).
+  struct Batches {
+    explicit Batches(const ReceiverDesign& d) : fixed(d), flt(d) {}
+    ReceiverFixedBatch fixed;
+    ReceiverFloatBatch flt;
+  };
+  // receive() on several streams (not observed): the streams run together through
+  // ReceiverFixedBatch or ReceiverFloatBatch (one per SIMD lane, bit for bit ReceiverFixed /
+  // ReceiverFloat per stream: tests/test_receiver_batch.cpp), so every result is receive()'s.
+  void receive_batch(std::vector<BatchStream>& streams, double scale, Batches& b) const {
     const double inv = 1.0 / scale;
+    if (!fixed()) {  // receive_float's: x = volts / scale, the filtered stream back in volts
+      std::vector<std::span<const double>> spans;
+      for (const auto& st : streams) spans.emplace_back(*st.volts);
+      std::vector<std::vector<Event>> ev;
+      std::vector<std::vector<double>> f;
+      const bool keep = scene->receiver.metrics.any();  // the filtered stream feeds the metrics only
+      b.flt.run(spans, inv, ev, keep ? &f : nullptr);
+      for (std::size_t i = 0; i < streams.size(); ++i) {
+        streams[i].events = std::move(ev[i]);
+        if (keep) {
+          streams[i].filtered = std::move(f[i]);
+          for (double& v : streams[i].filtered) v *= scale;
+        } else {
+          streams[i].filtered.assign(streams[i].volts->size(), 0.0);
+        }
+        streams[i].overflows = 0;
+      }
+      return;
+    }
+    ReceiverFixedBatch& batch = b.fixed;
     std::vector<std::vector<std::int64_t>> codes(streams.size());
     std::vector<std::span<const std::int64_t>> spans;
     std::vector<OverflowCounter> adc(streams.size());
@@ -790,8 +816,8 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   const bool keep_x = static_cast<bool>(capture);
   // A stream in three steps: prepare (assemble it and its compensation reference, noise, ADC),
   // receive (the receiver over both), finish (detections, compensation, matching). one() runs
-  // them on a stream; at the fixed precision, group() receives up to 8 streams together
-  // (ReceiverFixedBatch: one per SIMD lane), with the same results.
+  // them on a stream; group() receives up to 8 streams together (ReceiverFixedBatch or
+  // ReceiverFloatBatch: one per SIMD lane), with the same results.
   struct Prepared {
     std::vector<double> x, xr;          // the stream and its compensation reference (if any)
     std::vector<std::size_t> clipped;   // sample indices the input stage clipped
@@ -923,9 +949,10 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     receive_one(p);
     return finish(it, p, pb);
   };
-  // Streams [b, e) of items (at most 8), received together at the fixed precision.
-  const bool batched = lk.fixed() && !observer_;
-  auto group = [&](std::size_t b, std::size_t e, PearsonBank& pb, ReceiverFixedBatch& rb, StreamOut* outs) {
+  // Streams [b, e) of items (at most 8), received together (a fixed-stream observer sees one
+  // stream at a time).
+  const bool batched = !observer_;
+  auto group = [&](std::size_t b, std::size_t e, PearsonBank& pb, Link::Batches& rb, StreamOut* outs) {
     std::vector<Prepared> ps(e - b);
     for (std::size_t i = b; i < e; ++i) prepare(items[i], ps[i - b]);
     StageClock clk;
@@ -965,9 +992,9 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   };
   // The fixed-stream observer sees the streams in order: one thread then.
   const std::size_t jobs = (observer_ ? 1 : std::min<std::size_t>(static_cast<std::size_t>(std::max(jobs_, 1)), items.size()));
-  // Units of work: `per` consecutive streams (a group at the fixed precision, else one).
+  // Units of work: `per` consecutive streams (a group; one when observed).
   const std::size_t per = batched ? ReceiverFixedBatch::kLanes : 1;
-  auto run_unit = [&](std::size_t b, std::size_t e, PearsonBank& pb, ReceiverFixedBatch* rb, StreamOut* outs,
+  auto run_unit = [&](std::size_t b, std::size_t e, PearsonBank& pb, Link::Batches* rb, StreamOut* outs,
                       std::exception_ptr* errors) {
     if (rb) {
       try {
@@ -988,14 +1015,14 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   // Each worker has its own matched filter (PearsonBank owns FFTW buffers) and batch receiver.
   // Results are emitted in item order, so the output depends neither on jobs nor on grouping.
   std::vector<std::unique_ptr<PearsonBank>> banks;
-  std::vector<std::unique_ptr<ReceiverFixedBatch>> rbs;
+  std::vector<std::unique_ptr<Link::Batches>> rbs;
   for (std::size_t k = 0; k < jobs; ++k) {
     banks.push_back(k == 0 ? nullptr : std::make_unique<PearsonBank>(lk.templates));
-    if (batched) rbs.push_back(std::make_unique<ReceiverFixedBatch>(lk.design));
+    if (batched) rbs.push_back(std::make_unique<Link::Batches>(lk.design));
   }
   // Streams per round (the results of a round are held, then emitted in order): a few dozen
   // units per thread, so that streams of different lengths balance between the threads.
-  const std::size_t round = jobs <= 1 ? per : (batched ? 8 * per : 32) * jobs;
+  const std::size_t round = jobs <= 1 ? per : (batched ? 8 * per : 32) * jobs;  // 64 streams per thread
   for (std::size_t b0 = 0; b0 < items.size(); b0 += round) {
     const std::size_t b1 = std::min(items.size(), b0 + round);
     std::vector<StreamOut> outs(b1 - b0);
