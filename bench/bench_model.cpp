@@ -7,6 +7,7 @@
 //   Fixed/ReceiverBatch8  ReceiverFixedBatch: 8 streams (the same capture with different noise)
 //                    in the 8 lanes of the AVX-512 kernels (SIMD across streams); samples of
 //                    all 8 streams per second, on one core (label says which path ran)
+//   Float/ReceiverBatch8  ReceiverFloatBatch, the same for the float receiver
 //   Float/...        the same stages of the double-precision reference, block forms
 //                    (BandpassFloat::execute_block, CorrelatorBankFloat::feed,
 //                    ReceiverFloat::execute_block: what scenes and decode run)
@@ -140,6 +141,27 @@ void BM_FixedReceiverBatch8(benchmark::State& state) {
   state.SetLabel(batch.vectorized() ? "AVX-512" : "scalar per stream");
 }
 
+void BM_FloatReceiverBatch8(benchmark::State& state) {
+  const Setup& s = setup();
+  std::vector<std::vector<double>> streams;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  for (int l = 0; l < 8; ++l) {
+    std::vector<double> v;
+    for (double x : s.x) v.push_back(x + noise(rng));
+    streams.push_back(std::move(v));
+  }
+  std::vector<std::span<const double>> spans(streams.begin(), streams.end());
+  ReceiverFloatBatch batch(s.d);
+  std::vector<std::vector<Event>> ev;
+  for (auto _ : state) {
+    batch.run(spans, 1.0, ev);
+    benchmark::DoNotOptimize(ev.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 8 * static_cast<std::int64_t>(s.x.size()));
+  state.SetLabel(batch.vectorized() ? "AVX-512" : "scalar per stream");
+}
+
 void BM_FixedReceiverPerSample(benchmark::State& state) {
   const Setup& s = setup();
   ReceiverFixed rx(s.d);
@@ -253,6 +275,7 @@ BENCHMARK(BM_FixedReceiverPerSample)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FloatBandpass)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FloatBank)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FloatReceiver)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FloatReceiverBatch8)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WhiteNoise)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_StdNormalNoise)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Adc)->Unit(benchmark::kMicrosecond);

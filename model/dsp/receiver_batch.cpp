@@ -12,6 +12,10 @@ using batch::Lanes;
 
 static_assert(ReceiverFixedBatch::kLanes == static_cast<std::size_t>(kBatchLanes));
 
+namespace {
+constexpr std::size_t kChunk = 1024;  // samples per lane per pass of the kernels
+}  // namespace
+
 // The kernels' state, with the arrays BankBatch points into.
 struct ReceiverFixedBatch::Kernels {
   batch::BandpassBatch bp;
@@ -22,6 +26,7 @@ struct ReceiverFixedBatch::Kernels {
   std::vector<Lanes> b_re, b_im, y2h, bd_re, bd_im, f_re, f_im, q;
   OverflowCounter bp_events[kBatchLanes], mix_events[kBatchLanes], chip_events[kBatchLanes], corr_events[kBatchLanes];
   std::vector<Lanes> in, out;  // a chunk, lane-interleaved
+  std::vector<std::int64_t> zeros = std::vector<std::int64_t>(kChunk);  // an ended lane's input
 
   explicit Kernels(const ReceiverDesign& d)
       : filter(d.filter, d.config.bandpass), scalar(d.reference, d.config.correlator) {
@@ -172,7 +177,6 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
     if (len[l] == 0) finish(l);
   }
   const std::int64_t in_lo = fx_min_raw(k.filter.input_format()), in_hi = fx_max_raw(k.filter.input_format());
-  constexpr std::size_t kChunk = 1024;
   k.in.resize(kChunk);
   k.out.resize(kChunk);
   for (std::size_t n0 = 0, n = 0; n0 < longest; n0 += n) {
@@ -181,20 +185,25 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
     for (std::size_t l = 0; l < lanes; ++l) {
       if (len[l] > n0) n = std::min(n, len[l] - n0);
     }
-    // interleave: lane l's sample n0 + i at in[i].v[l]; lanes past their end get zeros
+    // Interleave: lane l's sample n0 + i at in[i].v[l]. A chunk ends at every lane's end, so
+    // a lane has all n samples of it or none (ended or unused: zeros, results discarded).
+    const std::int64_t* src[kBatchLanes];
     for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
-      const std::size_t have = l < lanes && len[l] > n0 ? std::min(n, len[l] - n0) : 0;
-      const std::int64_t* src = have > 0 ? streams[l].data() + n0 : nullptr;
-      std::int64_t mn = 0, mx = 0;
-      for (std::size_t i = 0; i < have; ++i) {
-        const std::int64_t v = src[i];
+      src[l] = l < lanes && len[l] > n0 ? streams[l].data() + n0 : k.zeros.data();
+    }
+    std::int64_t mn = 0, mx = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int l = 0; l < kBatchLanes; ++l) {
+        const std::int64_t v = src[l][i];
         k.in[i].v[l] = v;
         mn = v < mn ? v : mn;
         mx = v > mx ? v : mx;
       }
-      // the input range, checked once per chunk; the scalar check names the sample
-      if (mn < in_lo || mx > in_hi) k.filter.check_input(streams[l].subspan(n0, have));
-      for (std::size_t i = have; i < n; ++i) k.in[i].v[l] = 0;
+    }
+    if (mn < in_lo || mx > in_hi) {  // the input range, once per chunk; the scalar check names the sample
+      for (std::size_t l = 0; l < lanes; ++l) {
+        if (len[l] > n0) k.filter.check_input(streams[l].subspan(n0, n));
+      }
     }
     batch::bandpass_batch(k.bp, k.in.data(), k.out.data(), n);
     std::size_t i = 0;
@@ -229,6 +238,7 @@ struct ReceiverFloatBatch::Kernels {
   std::vector<double> taps, signs, gain;
   std::vector<LanesF> b_re, b_im, y2h, bd_re, bd_im, f_re, f_im, q;
   std::vector<LanesF> in, out;
+  std::vector<double> zeros = std::vector<double>(kChunk);  // an ended lane's input
 
   explicit Kernels(const ReceiverDesign& d) : scalar(d.reference) {
     const auto& sec = d.filter.sections;
@@ -342,7 +352,6 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
   for (std::size_t l = 0; l < lanes; ++l) {
     if (len[l] == 0) finish(l);
   }
-  constexpr std::size_t kChunk = 1024;
   k.in.resize(kChunk);
   k.out.resize(kChunk);
   for (std::size_t n0 = 0, n = 0; n0 < longest; n0 += n) {
@@ -351,11 +360,13 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
     for (std::size_t l = 0; l < lanes; ++l) {
       if (len[l] > n0) n = std::min(n, len[l] - n0);
     }
+    // Interleave (x = sample * gain): a lane has all n samples of the chunk or none (zeros).
+    const double* src[kBatchLanes];
     for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
-      const std::size_t have = l < lanes && len[l] > n0 ? std::min(n, len[l] - n0) : 0;
-      const double* src = have > 0 ? streams[l].data() + n0 : nullptr;
-      for (std::size_t i = 0; i < have; ++i) k.in[i].v[l] = src[i] * gain;
-      for (std::size_t i = have; i < n; ++i) k.in[i].v[l] = 0.0;
+      src[l] = l < lanes && len[l] > n0 ? streams[l].data() + n0 : k.zeros.data();
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int l = 0; l < kBatchLanes; ++l) k.in[i].v[l] = src[l][i] * gain;
     }
     batch::bandpass_batch_float(k.bp, k.in.data(), k.out.data(), n);
     if (filtered) {
