@@ -339,7 +339,7 @@ struct SceneSimulator::Link {
     const std::vector<double>* volts = nullptr;
     std::vector<std::size_t>* clamped = nullptr;  // receive()'s clamped
     std::vector<Event> events;
-    std::vector<double> filtered;
+    std::vector<double> filtered;  // empty when the scene names no metric
     std::uint64_t overflows = 0;  // added to receive()'s *ovf
   };
   // Both batch receivers of a worker (the one of the scene's precision is used).
@@ -365,9 +365,7 @@ struct SceneSimulator::Link {
         if (keep) {
           streams[i].filtered = std::move(f[i]);
           for (double& v : streams[i].filtered) v *= scale;
-        } else {
-          streams[i].filtered.assign(streams[i].volts->size(), 0.0);
-        }
+        }  // else empty: no metric reads it
         streams[i].overflows = 0;
       }
       return;
@@ -387,8 +385,8 @@ struct SceneSimulator::Link {
     batch.run(spans, raw, ovf);
     for (std::size_t i = 0; i < streams.size(); ++i) {
       auto& st = streams[i];
-      st.filtered.assign(st.volts->size(), 0.0);
-      if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only
+      if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only (else empty)
+        st.filtered.assign(st.volts->size(), 0.0);
         BandpassFloat bp(design.filter);
         bp.execute_block(std::span<const double>(*st.volts), std::span<double>(st.filtered));
       }
@@ -541,9 +539,14 @@ struct SceneSimulator::Link {
   // pb: the matched filter to use (PearsonBank is not thread-safe: one per worker thread).
   std::vector<Detection> detections(const std::vector<Event>& ev, const std::vector<double>& filtered, double t0,
                                     const std::vector<Burst>& schedule, PearsonBank& pb) {
+    return detections(ev, filtered, static_cast<long>(filtered.size()), t0, schedule, pb);
+  }
+  // n: the stream's length; filtered may be empty when the scene names no metric (none reads it).
+  std::vector<Detection> detections(const std::vector<Event>& ev, const std::vector<double>& filtered, long n,
+                                    double t0, const std::vector<Burst>& schedule, PearsonBank& pb) {
     std::vector<Detection> out;
-    for (auto& p : prepare(ev, static_cast<long>(filtered.size()), t0, schedule)) {
-      metrics(p.d, filtered, p.start, p.end, pb);
+    for (auto& p : prepare(ev, n, t0, schedule)) {
+      (void)metrics_window(p.d, filtered, 0, n, p.start, p.end, pb);
       out.push_back(p.d);
     }
     return out;
@@ -873,14 +876,15 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     const std::vector<double>& x = p.x;
     const std::vector<double>& f = p.f;
     std::vector<std::size_t>& clipped = p.clipped;
-    const auto dets = lk.detections(p.ev, f, 0.0, train, pb);
+    const long n = static_cast<long>(x.size());  // f is empty when no metric is named
+    const auto dets = lk.detections(p.ev, f, n, 0.0, train, pb);
     // Compensation: the reference path measures c (SceneCompensation).
     double c_est = s.receiver_speed();
     bool ref_missed = false;
     if (s.compensation) {
       const double dref = s.compensation->reference_distance_m;
       const Burst rb{train.front().code, 0.0};
-      const auto rdets = lk.detections(p.rev, p.fr, 0.0, {rb}, pb);
+      const auto rdets = lk.detections(p.rev, p.fr, static_cast<long>(p.xr.size()), 0.0, {rb}, pb);
       const double rtruth = dref / lk.c() * s.fs;
       int rbest = -1;
       for (std::size_t i = 0; i < rdets.size(); ++i) {
@@ -929,9 +933,9 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
         m.range_ambiguous = ru > 0 && m.det.code == m.code_sent && std::abs(m.error_m) >= ru / 2.0;
       } else {
         // The paper's metrics at the true alignment, T_d searched to the next burst.
-        long end = static_cast<long>(f.size());
+        long end = n;
         if (k + 1 < train.size()) end = std::lround((train[k + 1].tx_s + d / lk.c()) * s.fs);
-        lk.metrics(m.det, f, std::lround(truth), end, pb);
+        (void)lk.metrics_window(m.det, f, 0, n, std::lround(truth), end, pb);
       }
       // Without the pearson metric there is no Pearson decoder to err.
       m.pearson_error = s.receiver.metrics.pearson && (m.det.rho.empty() || m.det.pearson_code != m.code_sent);
