@@ -828,23 +828,29 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     std::vector<double> f, fr;          // the float bandpass over x and xr (for the metrics)
     StreamOut out;
   };
+  // Where a stream's bursts start (shifts, in samples) and its length; the clean bursts are in
+  // the link's cache already, so this only reads it.
+  auto stream_layout = [&](const Item& it, std::vector<long>* shifts) {
+    const double d = s.geometry.distances_m[it.di];
+    long end = 0;
+    for (const auto& b : trains[it.ti]) {
+      const Sparse& cb = lk.clean(b.code, d);
+      // Transmission times on the sample grid; the fractional part would need its own
+      // interpolation, so periods are rounded to samples (documented).
+      const long sh = std::lround(b.tx_s * s.fs);
+      if (shifts) shifts->push_back(sh);
+      end = std::max(end, cb.start + sh + static_cast<long>(cb.y.size()));
+    }
+    return static_cast<std::size_t>(std::max<long>(end, 0)) + lk.stream_tail();
+  };
   auto prepare = [&](const Item& it, Prepared& p) {
     StageClock clk;
     const double d = s.geometry.distances_m[it.di];
     const int rep = it.rep;
     const auto& train = trains[it.ti];
     // Assemble the stream.
-    long end = 0;
     std::vector<long> shifts;
-    for (const auto& b : train) {
-      const Sparse& cb = lk.clean(b.code, d);
-      // Transmission times on the sample grid; the fractional part would need its own
-      // interpolation, so periods are rounded to samples (documented).
-      const long sh = std::lround(b.tx_s * s.fs);
-      shifts.push_back(sh);
-      end = std::max(end, cb.start + sh + static_cast<long>(cb.y.size()));
-    }
-    p.x.assign(static_cast<std::size_t>(std::max<long>(end, 0)) + lk.stream_tail(), 0.0);
+    p.x.assign(stream_layout(it, &shifts), 0.0);
     for (std::size_t k = 0; k < train.size(); ++k) Link::add_into(p.x, lk.clean(train[k].code, d), shifts[k]);
     const double sigma = noise_sigma(train, d);
     add_noise_and_adc(p.x, sigma, d, rep, train, 0, p.clipped);
@@ -996,11 +1002,25 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   };
   // The fixed-stream observer sees the streams in order: one thread then.
   const std::size_t jobs = (observer_ ? 1 : std::min<std::size_t>(static_cast<std::size_t>(std::max(jobs_, 1)), items.size()));
-  // Units of work: `per` consecutive streams (a group; one when observed).
-  const std::size_t per = batched ? ReceiverFixedBatch::kLanes : 1;
+  // Units of work: consecutive streams received together, up to 8 of them and at most
+  // kGroupSamples samples between them, so a group holds no more memory than a few long streams
+  // (a stream longer than that, or any stream when observed, is a unit alone and runs one()).
+  constexpr std::size_t kGroupSamples = std::size_t{1} << 22;  // 4 M samples: ~100 MB of a group's arrays
+  std::vector<std::pair<std::size_t, std::size_t>> units;  // [b, e) of items
+  for (std::size_t i = 0; i < items.size();) {
+    std::size_t e = i + 1, total = stream_layout(items[i], nullptr);
+    while (batched && e < items.size() && e - i < ReceiverFixedBatch::kLanes) {
+      const std::size_t next = stream_layout(items[e], nullptr);
+      if (total + next > kGroupSamples) break;
+      total += next;
+      ++e;
+    }
+    units.emplace_back(i, e);
+    i = e;
+  }
   auto run_unit = [&](std::size_t b, std::size_t e, PearsonBank& pb, Link::Batches* rb, StreamOut* outs,
                       std::exception_ptr* errors) {
-    if (rb) {
+    if (rb && e - b > 1) {
       try {
         group(b, e, pb, *rb, outs);
         return;
@@ -1016,7 +1036,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
       }
     }
   };
-  // Each worker has its own matched filter (PearsonBank owns FFTW buffers) and batch receiver.
+  // Each worker has its own matched filter (PearsonBank owns FFTW buffers) and batch receivers.
   // Results are emitted in item order, so the output depends neither on jobs nor on grouping.
   std::vector<std::unique_ptr<PearsonBank>> banks;
   std::vector<std::unique_ptr<Link::Batches>> rbs;
@@ -1024,23 +1044,23 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     banks.push_back(k == 0 ? nullptr : std::make_unique<PearsonBank>(lk.templates));
     if (batched) rbs.push_back(std::make_unique<Link::Batches>(lk.design));
   }
-  // Streams per round (the results of a round are held, then emitted in order): a few dozen
-  // units per thread, so that streams of different lengths balance between the threads.
-  const std::size_t round = jobs <= 1 ? per : (batched ? 8 * per : 32) * jobs;  // 64 streams per thread
-  for (std::size_t b0 = 0; b0 < items.size(); b0 += round) {
-    const std::size_t b1 = std::min(items.size(), b0 + round);
+  // Units per round (a round's results are held, then emitted in order): several per thread,
+  // so that streams of different lengths balance between the threads.
+  const std::size_t round = jobs <= 1 ? 1 : 8 * jobs;
+  for (std::size_t u0 = 0; u0 < units.size(); u0 += round) {
+    const std::size_t u1 = std::min(units.size(), u0 + round);
+    const std::size_t b0 = units[u0].first, b1 = units[u1 - 1].second;
     std::vector<StreamOut> outs(b1 - b0);
     std::vector<std::exception_ptr> errors(b1 - b0);  // per stream: the first in stream order is thrown
-    const std::size_t units = (b1 - b0 + per - 1) / per;
     auto unit = [&](std::size_t u, std::size_t t) {
-      const std::size_t b = b0 + u * per, e = std::min(b1, b + per);
+      const auto [b, e] = units[u0 + u];
       run_unit(b, e, t == 0 ? *lk.bank : *banks[t], batched ? rbs[t].get() : nullptr, outs.data() + (b - b0),
                errors.data() + (b - b0));
     };
     if (jobs <= 1) {
-      for (std::size_t u = 0; u < units; ++u) unit(u, 0);
+      for (std::size_t u = 0; u < u1 - u0; ++u) unit(u, 0);
     } else {
-      parallel_items(units, jobs, unit);
+      parallel_items(u1 - u0, jobs, unit);
     }
     for (std::size_t i = b0; i < b1; ++i) {
       // As with one thread: the streams before a failing one are emitted, then its error.
