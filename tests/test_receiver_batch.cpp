@@ -192,7 +192,9 @@ TEST(ReceiverBatch, FloatMatchesTheScalarReceiverPerStreamBitForBit) {
         EXPECT_EQ(std::memcmp(&events[s][i].margin, &want[i].margin, sizeof(double)), 0) << family << " " << s;
       }
       ASSERT_EQ(filtered[s].size(), f.size());
-      EXPECT_EQ(std::memcmp(filtered[s].data(), f.data(), f.size() * sizeof(double)), 0) << family << " stream " << s;
+      if (!f.empty()) {  // (memcmp of an empty vector's null data is undefined)
+        EXPECT_EQ(std::memcmp(filtered[s].data(), f.data(), f.size() * sizeof(double)), 0) << family << " stream " << s;
+      }
       detected += want.size();
     }
     EXPECT_GT(detected, volts.size()) << family;
