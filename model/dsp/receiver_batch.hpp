@@ -1,6 +1,8 @@
 #pragma once
-// ReceiverFixedBatch: the fixed receiver (receiver.hpp: bandpass, correlator bank, detector) on
-// up to kLanes independent streams at once, one stream per SIMD lane ("SIMD across streams").
+// ReceiverFixedBatch / ReceiverFloatBatch: the fixed and float receivers (receiver.hpp:
+// bandpass, correlator bank, detector) on up to kLanes independent streams at once, one stream
+// per SIMD lane ("SIMD across streams"). What follows is said of the fixed one; the float one
+// is built the same way (below).
 //
 // Each stream's events and overflow counts are bit for bit what a fresh ReceiverFixed gives for
 // that stream through execute_block and flush_raw (tests/test_receiver_batch.cpp). Streams may
