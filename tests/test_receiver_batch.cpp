@@ -52,6 +52,12 @@ std::vector<std::vector<std::int64_t>> make_streams(const ReceiverDesign& d, con
   return out;
 }
 
+// 11 streams: two batches, the second partial; lengths around a decimated output's end (D).
+std::vector<std::size_t> mixed_lengths(const ReceiverDesign& d) {
+  const auto dec = static_cast<std::size_t>(d.layout.decimation);
+  return {30011, 24000, 9000, 0, 1, dec - 1, dec, dec + 1, 17777, 30011, 5003};
+}
+
 // Every stream through the batch and through its own ReceiverFixed; returns the total
 // overflow count (so a case can assert it exercised the overflow path).
 std::uint64_t expect_same(const ReceiverDesign& d, const std::vector<std::vector<std::int64_t>>& streams,
@@ -87,12 +93,7 @@ TEST(ReceiverBatch, MatchesTheScalarReceiverPerStreamOfAnyLength) {
     cfg.family = family;
     fit_decimation_to_chip(cfg);
     const ReceiverDesign d = design_receiver(cfg);
-    const int dec = d.layout.decimation;
-    // 11 streams: two batches, the second partial; lengths around a decimated output's end.
-    const std::vector<std::size_t> lengths = {30011, 24000, 9000, 0, 1, static_cast<std::size_t>(dec - 1),
-                                              static_cast<std::size_t>(dec), static_cast<std::size_t>(dec + 1),
-                                              17777, 30011, 5003};
-    const auto streams = make_streams(d, lengths, 11);
+    const auto streams = make_streams(d, mixed_lengths(d), 11);
     const std::uint64_t ovf = expect_same(d, streams, family);
     std::printf("[ receiver batch ] %s: %s path, %llu overflow events compared\n", family,
                 ReceiverFixedBatch(d).vectorized() ? "AVX-512" : "scalar", static_cast<unsigned long long>(ovf));
@@ -159,13 +160,9 @@ TEST(ReceiverBatch, FloatMatchesTheScalarReceiverPerStreamBitForBit) {
     cfg.family = family;
     fit_decimation_to_chip(cfg);
     const ReceiverDesign d = design_receiver(cfg);
-    const int dec = d.layout.decimation;
-    const std::vector<std::size_t> lengths = {30011, 24000, 9000, 0, 1, static_cast<std::size_t>(dec - 1),
-                                              static_cast<std::size_t>(dec), static_cast<std::size_t>(dec + 1),
-                                              17777, 30011, 5003};
     // volts: the codes' streams as doubles at an arbitrary scale, so the gain's rounding matters
     std::vector<std::vector<double>> volts;
-    for (const auto& q : make_streams(d, lengths, 13)) {
+    for (const auto& q : make_streams(d, mixed_lengths(d), 13)) {
       std::vector<double> v;
       for (auto c : q) v.push_back(0.037 * static_cast<double>(c) + 1e-7 * static_cast<double>(v.size() % 7));
       volts.push_back(std::move(v));

@@ -9,11 +9,42 @@ namespace ranging {
 
 using batch::kBatchLanes;
 using batch::Lanes;
+using batch::LanesF;
 
 static_assert(ReceiverFixedBatch::kLanes == static_cast<std::size_t>(kBatchLanes));
 
 namespace {
 constexpr std::size_t kChunk = 1024;  // samples per lane per pass of the kernels
+
+// The bank's arrays of a batch (Lanes or LanesF), zeroed, and the kernel state pointed at them
+// in the scalar bank's reset positions (the rings' newest slot is the last one).
+template <class L, class Bank>
+struct BankArrays {
+  std::vector<L> b_re, b_im, y2h, bd_re, bd_im, f_re, f_im, q;
+  void reset(Bank& b) {
+    b_re.assign(static_cast<std::size_t>(b.period), L{});
+    b_im.assign(b_re.size(), L{});
+    y2h.assign(b.window, L{});
+    bd_re.assign(2 * b.bd_n, L{});
+    bd_im.assign(2 * b.bd_n, L{});
+    f_re.assign(2 * b.f_n, L{});
+    f_im.assign(2 * b.f_n, L{});
+    q.assign(static_cast<std::size_t>(b.codes), L{});
+    b.b_re = b_re.data();
+    b.b_im = b_im.data();
+    b.y2h = y2h.data();
+    b.bd_re = bd_re.data();
+    b.bd_im = bd_im.data();
+    b.f_re = f_re.data();
+    b.f_im = f_im.data();
+    b.q = q.data();
+    b.dec_phase = 0;
+    b.y_idx = b.window - 1;
+    b.bd_idx = b.bd_n - 1;
+    b.f_idx = b.f_n - 1;
+    b.acc_re = b.acc_im = b.energy = L{};
+  }
+};
 }  // namespace
 
 // The kernels' state, with the arrays BankBatch points into.
@@ -23,7 +54,7 @@ struct ReceiverFixedBatch::Kernels {
   BandpassFixed filter;        // the scalar objects the constants come from (and the input
   CorrelatorBankFixed scalar;  //   range check)
   std::vector<std::int64_t> lo_cos, lo_nsin, taps_rev, sign_mask, weights;
-  std::vector<Lanes> b_re, b_im, y2h, bd_re, bd_im, f_re, f_im, q;
+  BankArrays<Lanes, batch::BankBatch> arrays;
   OverflowCounter bp_events[kBatchLanes], mix_events[kBatchLanes], chip_events[kBatchLanes], corr_events[kBatchLanes];
   std::vector<Lanes> in, out;  // a chunk, lane-interleaved
   std::vector<std::int64_t> zeros = std::vector<std::int64_t>(kChunk);  // an ended lane's input
@@ -92,28 +123,8 @@ struct ReceiverFixedBatch::Kernels {
     std::fill(std::begin(bp.y1), std::end(bp.y1), Lanes{});
     std::fill(std::begin(bp.y2), std::end(bp.y2), Lanes{});
     bp.x1 = bp.x2 = Lanes{};
-    b_re.assign(static_cast<std::size_t>(b.period), Lanes{});
-    b_im.assign(b_re.size(), Lanes{});
-    y2h.assign(b.window, Lanes{});
-    bd_re.assign(2 * b.bd_n, Lanes{});
-    bd_im.assign(2 * b.bd_n, Lanes{});
-    f_re.assign(2 * b.f_n, Lanes{});
-    f_im.assign(2 * b.f_n, Lanes{});
-    q.assign(static_cast<std::size_t>(b.codes), Lanes{});
-    b.b_re = b_re.data();
-    b.b_im = b_im.data();
-    b.y2h = y2h.data();
-    b.bd_re = bd_re.data();
-    b.bd_im = bd_im.data();
-    b.f_re = f_re.data();
-    b.f_im = f_im.data();
-    b.q = q.data();
-    // CorrelatorBankFixed::reset's positions: the rings' newest slot is the last one
-    b.phase = b.dec_phase = 0;
-    b.y_idx = b.window - 1;
-    b.bd_idx = b.bd_n - 1;
-    b.f_idx = b.f_n - 1;
-    b.acc_re = b.acc_im = b.energy = Lanes{};
+    arrays.reset(b);  // CorrelatorBankFixed::reset's positions
+    b.phase = 0;
     for (int l = 0; l < kBatchLanes; ++l) bp_events[l] = mix_events[l] = chip_events[l] = corr_events[l] = {};
   }
 };
@@ -215,7 +226,7 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
       if (ready) {
         for (std::size_t l = 0; l < lanes; ++l) {
           if (!open[l]) continue;
-          for (std::size_t j = 0; j < codes; ++j) qv[j] = static_cast<std::uint64_t>(k.q[j].v[l]);
+          for (std::size_t j = 0; j < codes; ++j) qv[j] = static_cast<std::uint64_t>(k.bank.q[j].v[l]);
           const std::uint64_t norm = static_cast<std::uint64_t>(k.bank.energy.v[l]) >> energy_shift;
           if (auto e = det[l].execute(qv, static_cast<std::int64_t>(last), norm)) events[l].push_back(*e);
         }
@@ -229,14 +240,13 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
 
 // ---- float -----------------------------------------------------------------------------
 
-using batch::LanesF;
 
 struct ReceiverFloatBatch::Kernels {
   batch::FloatBandpassBatch bp;
   batch::FloatBankBatch bank;
   CorrelatorBankFloat scalar;  // the LO tables come from it
   std::vector<double> taps, signs, gain;
-  std::vector<LanesF> b_re, b_im, y2h, bd_re, bd_im, f_re, f_im, q;
+  BankArrays<LanesF, batch::FloatBankBatch> arrays;
   std::vector<LanesF> in, out;
   std::vector<double> zeros = std::vector<double>(kChunk);  // an ended lane's input
 
@@ -273,29 +283,8 @@ struct ReceiverFloatBatch::Kernels {
   void reset() {
     auto& b = bank;
     for (int k = 0; k < batch::kBatchMaxSections; ++k) bp.x1[k] = bp.x2[k] = bp.y1[k] = bp.y2[k] = LanesF{};
-    b_re.assign(static_cast<std::size_t>(b.period), LanesF{});
-    b_im.assign(b_re.size(), LanesF{});
-    y2h.assign(b.window, LanesF{});
-    bd_re.assign(2 * b.bd_n, LanesF{});
-    bd_im.assign(2 * b.bd_n, LanesF{});
-    f_re.assign(2 * b.f_n, LanesF{});
-    f_im.assign(2 * b.f_n, LanesF{});
-    q.assign(static_cast<std::size_t>(b.codes), LanesF{});
-    b.b_re = b_re.data();
-    b.b_im = b_im.data();
-    b.y2h = y2h.data();
-    b.bd_re = bd_re.data();
-    b.bd_im = bd_im.data();
-    b.f_re = f_re.data();
-    b.f_im = f_im.data();
-    b.q = q.data();
-    // CorrelatorBankFloat::reset's positions
+    arrays.reset(b);  // CorrelatorBankFloat::reset's positions
     b.b_idx = 0;
-    b.dec_phase = 0;
-    b.y_idx = b.window - 1;
-    b.bd_idx = b.bd_n - 1;
-    b.f_idx = b.f_n - 1;
-    b.acc_re = b.acc_im = b.energy = LanesF{};
   }
 };
 
@@ -384,7 +373,7 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
       const std::int64_t last = static_cast<std::int64_t>(n0 + i - 1);
       for (std::size_t l = 0; l < lanes; ++l) {
         if (!open[l]) continue;
-        for (std::size_t j = 0; j < codes; ++j) qv[j] = k.q[j].v[l];
+        for (std::size_t j = 0; j < codes; ++j) qv[j] = k.bank.q[j].v[l];
         if (auto e = det[l].execute(qv, last, k.bank.energy.v[l])) events[l].push_back(*e);
       }
     }
