@@ -198,3 +198,23 @@ TEST(ReceiverBatch, FloatMatchesTheScalarReceiverPerStreamBitForBit) {
     std::printf("[ receiver batch ] float %s: %s path\n", family, batch.vectorized() ? "AVX-512" : "scalar");
   }
 }
+
+// The bank's combiner saturations through the batch: a corr_shift 4 below the automatic one
+// makes the loud streams saturate C_q (the scalar receiver's count is asserted non-zero), and
+// the batch's total per stream must equal the scalar receiver's. (F_q keeps >= 6 dB over a
+// full-scale input, so no clamped input reaches its top; the mixer has y's integer bits.)
+TEST(ReceiverBatch, CountsTheCombinersSaturationsPerStream) {
+  ReceiverConfig cfg;
+  cfg.correlator.corr_shift = design_receiver(cfg).layout.corr_shift - 4;
+  const ReceiverDesign d = design_receiver(cfg);
+  const auto streams = make_streams(d, {20000, 20000, 20000, 9000, 15000}, 17);
+  expect_same(d, streams, "corr_shift - 4");
+  std::uint64_t corr = 0;
+  for (const auto& s : streams) {
+    ReceiverFixed rx(d);
+    std::vector<EventFixed> ev;
+    rx.execute_block(s, ev);
+    corr += rx.bank().corr_overflow_events().total();
+  }
+  EXPECT_GT(corr, 0u);
+}

@@ -172,10 +172,7 @@ class CorrelatorBankFixed {
   const CorrelatorFixedLayout& layout() const { return layout_; }
   const CorrelatorFixedConfig& config() const { return cfg_; }
   // Saturation events: all nodes, and per saturating node (mixer B, chip F_q, corr C_q).
-  OverflowCounter overflow_events() const {
-    return {mix_events_.saturations + chip_events_.saturations + corr_events_.saturations,
-            mix_events_.wraps + chip_events_.wraps + corr_events_.wraps};
-  }
+  OverflowCounter overflow_events() const { return mix_events_ + chip_events_ + corr_events_; }
   OverflowCounter mix_overflow_events() const { return mix_events_; }
   OverflowCounter chip_overflow_events() const { return chip_events_; }
   OverflowCounter corr_overflow_events() const { return corr_events_; }

@@ -52,6 +52,12 @@ struct OverflowCounter {
   std::uint64_t saturations = 0;
   std::uint64_t wraps = 0;
   std::uint64_t total() const { return saturations + wraps; }
+  OverflowCounter& operator+=(const OverflowCounter& o) {
+    saturations += o.saturations;
+    wraps += o.wraps;
+    return *this;
+  }
+  friend OverflowCounter operator+(OverflowCounter a, const OverflowCounter& b) { return a += b; }
 };
 
 // Quantize raw * 2^-src_frac into fmt: round away the surplus fraction bits by fmt.rounding,

@@ -327,12 +327,7 @@ std::optional<Event> ReceiverFixed::flush() {
 }
 
 OverflowCounter ReceiverFixed::overflow_events() const {
-  OverflowCounter c = input_counter_;
-  const OverflowCounter f = filter_.overflow_events();
-  const OverflowCounter b = bank_.overflow_events();
-  c.saturations += f.saturations + b.saturations;
-  c.wraps += f.wraps + b.wraps;
-  return c;
+  return input_counter_ + filter_.overflow_events() + bank_.overflow_events();
 }
 
 }  // namespace ranging

@@ -45,14 +45,52 @@ struct BankArrays {
     b.acc_re = b.acc_im = b.energy = L{};
   }
 };
+
+// The chunk loop of both batch receivers. The lanes run to the longest stream in chunks of at
+// most kChunk samples, and a chunk ends at every lane's end: a lane has all n samples of a
+// chunk or none, and finish(l) runs right after lane l's last sample (before the first chunk
+// for an empty stream), so a lane's counters and its detector's flush are read at its own end.
+// chunk(n0, n, src, open) processes samples [n0, n0 + n): src[l] points at lane l's sample n0,
+// or at `zeros` (>= kChunk of them) for an ended or unused lane, whose results are discarded;
+// open[l] says whether lane l is still running.
+template <class T, class Chunk, class Finish>
+void run_chunks(std::span<const std::span<const T>> streams, const T* zeros, Chunk&& chunk, Finish&& finish) {
+  const std::size_t lanes = streams.size();
+  std::size_t longest = 0;
+  bool open[kBatchLanes] = {};
+  const auto close = [&](std::size_t l) {
+    finish(l);
+    open[l] = false;
+  };
+  for (std::size_t l = 0; l < lanes; ++l) {
+    longest = std::max(longest, streams[l].size());
+    open[l] = true;
+  }
+  for (std::size_t l = 0; l < lanes; ++l) {
+    if (streams[l].empty()) close(l);
+  }
+  for (std::size_t n0 = 0, n = 0; n0 < longest; n0 += n) {
+    n = std::min(kChunk, longest - n0);
+    for (std::size_t l = 0; l < lanes; ++l) {
+      if (streams[l].size() > n0) n = std::min(n, streams[l].size() - n0);
+    }
+    const T* src[kBatchLanes];
+    for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
+      src[l] = l < lanes && streams[l].size() > n0 ? streams[l].data() + n0 : zeros;
+    }
+    chunk(n0, n, src, static_cast<const bool*>(open));
+    for (std::size_t l = 0; l < lanes; ++l) {
+      if (open[l] && streams[l].size() == n0 + n) close(l);
+    }
+  }
+}
 }  // namespace
 
 // The kernels' state, with the arrays BankBatch points into.
 struct ReceiverFixedBatch::Kernels {
   batch::BandpassBatch bp;
   batch::BankBatch bank;
-  BandpassFixed filter;        // the scalar objects the constants come from (and the input
-  CorrelatorBankFixed scalar;  //   range check)
+  BandpassFixed filter;  // the scalar filter the constants come from (and the input range check)
   std::vector<std::int64_t> lo_cos, lo_nsin, taps_rev, sign_mask, weights;
   BankArrays<Lanes, batch::BankBatch> arrays;
   OverflowCounter bp_events[kBatchLanes], mix_events[kBatchLanes], chip_events[kBatchLanes], corr_events[kBatchLanes];
@@ -60,7 +98,7 @@ struct ReceiverFixedBatch::Kernels {
   std::vector<std::int64_t> zeros = std::vector<std::int64_t>(kChunk);  // an ended lane's input
 
   explicit Kernels(const ReceiverDesign& d)
-      : filter(d.filter, d.config.bandpass), scalar(d.reference, d.config.correlator) {
+      : filter(d.filter, d.config.bandpass) {
     const auto& cfg = filter.config();
     const auto& coef = filter.coefficients();
     bp.sections = static_cast<int>(coef.size());
@@ -79,8 +117,8 @@ struct ReceiverFixedBatch::Kernels {
     bp.sym = filter.sym();
     bp.events = bp_events;
 
-    const auto& l = scalar.layout();
-    const auto& cc = scalar.config();
+    const auto& l = d.layout;
+    const auto& cc = d.config.correlator;
     auto& b = bank;
     b.period = l.period;
     b.decimation = l.decimation;
@@ -162,46 +200,16 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
   Kernels& k = *k_;
   k.reset();
   const std::size_t lanes = streams.size();
-  std::size_t len[kBatchLanes] = {}, longest = 0;
-  for (std::size_t l = 0; l < lanes; ++l) {
-    len[l] = streams[l].size();
-    longest = std::max(longest, len[l]);
-  }
-  std::vector<PeakDetectorFixed> det(lanes, PeakDetectorFixed(design_.config.detector, k.scalar.layout(),
+  std::vector<PeakDetectorFixed> det(lanes, PeakDetectorFixed(design_.config.detector, design_.layout,
                                                               design_.config.correlator));
-  const int energy_shift = k.scalar.layout().energy_shift;
+  const int energy_shift = design_.layout.energy_shift;
   const std::size_t codes = static_cast<std::size_t>(k.bank.codes);
   std::vector<std::uint64_t> qv(codes);
-  bool open[kBatchLanes] = {};
-  auto finish = [&](std::size_t l) {  // lane l's last sample is in: flush, read its counters
-    if (auto e = det[l].flush()) events[l].push_back(*e);
-    OverflowCounter c = k.bp_events[l];
-    for (const OverflowCounter* o : {&k.mix_events[l], &k.chip_events[l], &k.corr_events[l]}) {
-      c.saturations += o->saturations;
-      c.wraps += o->wraps;
-    }
-    overflows[l] = c;
-    open[l] = false;
-  };
-  for (std::size_t l = 0; l < lanes; ++l) {
-    open[l] = true;
-    if (len[l] == 0) finish(l);
-  }
   const std::int64_t in_lo = fx_min_raw(k.filter.input_format()), in_hi = fx_max_raw(k.filter.input_format());
   k.in.resize(kChunk);
   k.out.resize(kChunk);
-  for (std::size_t n0 = 0, n = 0; n0 < longest; n0 += n) {
-    // A chunk ends at the next lane's end, so a lane's counters are read after its last sample.
-    n = std::min(kChunk, longest - n0);
-    for (std::size_t l = 0; l < lanes; ++l) {
-      if (len[l] > n0) n = std::min(n, len[l] - n0);
-    }
-    // Interleave: lane l's sample n0 + i at in[i].v[l]. A chunk ends at every lane's end, so
-    // a lane has all n samples of it or none (ended or unused: zeros, results discarded).
-    const std::int64_t* src[kBatchLanes];
-    for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
-      src[l] = l < lanes && len[l] > n0 ? streams[l].data() + n0 : k.zeros.data();
-    }
+  const auto chunk = [&](std::size_t n0, std::size_t n, const std::int64_t* const* src, const bool* open) {
+    // Interleave: lane l's sample n0 + i at in[i].v[l].
     std::int64_t mn = 0, mx = 0;
     for (std::size_t i = 0; i < n; ++i) {
       for (int l = 0; l < kBatchLanes; ++l) {
@@ -213,29 +221,28 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
     }
     if (mn < in_lo || mx > in_hi) {  // the input range, once per chunk; the scalar check names the sample
       for (std::size_t l = 0; l < lanes; ++l) {
-        if (len[l] > n0) k.filter.check_input(streams[l].subspan(n0, n));
+        if (open[l]) k.filter.check_input(streams[l].subspan(n0, n));
       }
     }
     batch::bandpass_batch(k.bp, k.in.data(), k.out.data(), n);
-    std::size_t i = 0;
-    while (i < n) {
+    for (std::size_t i = 0; i < n;) {
       bool ready = false;
-      const std::size_t used = batch::bank_feed_batch(k.bank, k.out.data() + i, n - i, &ready);
-      i += used;
-      const std::size_t last = n0 + i - 1;  // index of the last sample fed
-      if (ready) {
-        for (std::size_t l = 0; l < lanes; ++l) {
-          if (!open[l]) continue;
-          for (std::size_t j = 0; j < codes; ++j) qv[j] = static_cast<std::uint64_t>(k.bank.q[j].v[l]);
-          const std::uint64_t norm = static_cast<std::uint64_t>(k.bank.energy.v[l]) >> energy_shift;
-          if (auto e = det[l].execute(qv, static_cast<std::int64_t>(last), norm)) events[l].push_back(*e);
-        }
+      i += batch::bank_feed_batch(k.bank, k.out.data() + i, n - i, &ready);
+      if (!ready) continue;
+      const auto last = static_cast<std::int64_t>(n0 + i - 1);  // index of the last sample fed
+      for (std::size_t l = 0; l < lanes; ++l) {
+        if (!open[l]) continue;
+        for (std::size_t j = 0; j < codes; ++j) qv[j] = static_cast<std::uint64_t>(k.bank.q[j].v[l]);
+        const std::uint64_t norm = static_cast<std::uint64_t>(k.bank.energy.v[l]) >> energy_shift;
+        if (auto e = det[l].execute(qv, last, norm)) events[l].push_back(*e);
       }
     }
-    for (std::size_t l = 0; l < lanes; ++l) {
-      if (open[l] && len[l] == n0 + n) finish(l);
-    }
-  }
+  };
+  const auto finish = [&](std::size_t l) {  // lane l's last sample is in: flush, read its counters
+    if (auto e = det[l].flush()) events[l].push_back(*e);
+    overflows[l] = k.bp_events[l] + k.mix_events[l] + k.chip_events[l] + k.corr_events[l];
+  };
+  run_chunks(streams, k.zeros.data(), chunk, finish);
 }
 
 // ---- float -----------------------------------------------------------------------------
@@ -324,36 +331,13 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
   Kernels& k = *k_;
   k.reset();
   const std::size_t lanes = streams.size();
-  std::size_t len[kBatchLanes] = {}, longest = 0;
-  for (std::size_t l = 0; l < lanes; ++l) {
-    len[l] = streams[l].size();
-    longest = std::max(longest, len[l]);
-  }
   std::vector<PeakDetectorFloat> det(lanes, PeakDetectorFloat(design_.config.detector, design_.reference));
   const std::size_t codes = static_cast<std::size_t>(k.bank.codes);
   std::vector<double> qv(codes);
-  bool open[kBatchLanes] = {};
-  for (std::size_t l = 0; l < lanes; ++l) open[l] = true;
-  auto finish = [&](std::size_t l) {
-    if (auto e = det[l].flush()) events[l].push_back(*e);
-    open[l] = false;
-  };
-  for (std::size_t l = 0; l < lanes; ++l) {
-    if (len[l] == 0) finish(l);
-  }
   k.in.resize(kChunk);
   k.out.resize(kChunk);
-  for (std::size_t n0 = 0, n = 0; n0 < longest; n0 += n) {
-    // A chunk ends at the next lane's end (its detector is flushed after its last sample).
-    n = std::min(kChunk, longest - n0);
-    for (std::size_t l = 0; l < lanes; ++l) {
-      if (len[l] > n0) n = std::min(n, len[l] - n0);
-    }
-    // Interleave (x = sample * gain): a lane has all n samples of the chunk or none (zeros).
-    const double* src[kBatchLanes];
-    for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
-      src[l] = l < lanes && len[l] > n0 ? streams[l].data() + n0 : k.zeros.data();
-    }
+  const auto chunk = [&](std::size_t n0, std::size_t n, const double* const* src, const bool* open) {
+    // Interleave, x = sample * gain.
     for (std::size_t i = 0; i < n; ++i) {
       for (int l = 0; l < kBatchLanes; ++l) k.in[i].v[l] = src[l][i] * gain;
     }
@@ -365,22 +349,22 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
         for (std::size_t i = 0; i < n; ++i) dst[i] = k.out[i].v[l];
       }
     }
-    std::size_t i = 0;
-    while (i < n) {
+    for (std::size_t i = 0; i < n;) {
       bool ready = false;
       i += batch::bank_feed_batch_float(k.bank, k.out.data() + i, n - i, &ready);
       if (!ready) continue;
-      const std::int64_t last = static_cast<std::int64_t>(n0 + i - 1);
+      const auto last = static_cast<std::int64_t>(n0 + i - 1);
       for (std::size_t l = 0; l < lanes; ++l) {
         if (!open[l]) continue;
         for (std::size_t j = 0; j < codes; ++j) qv[j] = k.bank.q[j].v[l];
         if (auto e = det[l].execute(qv, last, k.bank.energy.v[l])) events[l].push_back(*e);
       }
     }
-    for (std::size_t l = 0; l < lanes; ++l) {
-      if (open[l] && len[l] == n0 + n) finish(l);
-    }
-  }
+  };
+  const auto finish = [&](std::size_t l) {
+    if (auto e = det[l].flush()) events[l].push_back(*e);
+  };
+  run_chunks(streams, k.zeros.data(), chunk, finish);
 }
 
 }  // namespace ranging
