@@ -378,8 +378,11 @@ module bandpass_sos #(
       end
       // Address of depth d after this clock (w: the section writes now): ring
       // word wp - (1 + d - w) (mod 4, table, no adder), or word 8 if not written.
+      // Words 8..15 are never written (zero): reset reads one of them by setting
+      // the address MSB at the read port, so the addresses depend on registers
+      // only (no input-to-address logic for a simulator to settle).
       function [3:0] raddr;
-        input       sec, w, clr;
+        input       sec, w;
         input [1:0] wp;
         input [2:0] vd;
         input [1:0] d;
@@ -394,26 +397,26 @@ module bandpass_sos #(
             default: a = {wp[1] ^ wp[0], ~wp[0]};
           endcase
           ok = (d == 2'd0) ? (w | vd[0]) : (d == 2'd1) ? (w ? vd[0] : vd[1]) : (w ? vd[1] : vd[2]);
-          raddr = (clr || !ok) ? 4'd8 : {1'b0, sec, a};
+          raddr = !ok ? 4'd8 : {1'b0, sec, a};
         end
       endfunction
       reg  [3:0] pa;
       always @(*) begin
         case (nr)
-          3'd0:    pa = raddr(1'b0, wr_a, rst, wp_a, vd_a, 2'd1);
-          3'd3:    pa = raddr(1'b1, wr_b, rst, wp_b, vd_b, 2'd1);
-          3'd4:    pa = raddr(1'b1, wr_b, rst, wp_b, vd_b, 2'd0);
-          default: pa = raddr(1'b0, wr_a, rst, wp_a, vd_a, 2'd0);
+          3'd0:    pa = raddr(1'b0, wr_a, wp_a, vd_a, 2'd1);
+          3'd3:    pa = raddr(1'b1, wr_b, wp_b, vd_b, 2'd1);
+          3'd4:    pa = raddr(1'b1, wr_b, wp_b, vd_b, 2'd0);
+          default: pa = raddr(1'b0, wr_a, wp_a, vd_a, 2'd0);
         endcase
       end
       // second port: A depth 2 for slot 5 (b's x2), B depth 2 for slot 3 (pair i+1's a x2)
-      wire [3:0] qa = (nr == 3'd3) ? raddr(1'b1, wr_b, rst, wp_b, vd_b, 2'd2)
-                                   : raddr(1'b0, wr_a, rst, wp_a, vd_a, 2'd2);
+      wire [3:0] qa = (nr == 3'd3) ? raddr(1'b1, wr_b, wp_b, vd_b, 2'd2)
+                                   : raddr(1'b0, wr_a, wp_a, vd_a, 2'd2);
       always @(posedge clk) begin
         if (wr_a || wr_b) hmem[{1'b0, wr_b, wr_b ? wp_b : wp_a}] <= pair_y[i*DATA_W +: DATA_W];
         if (run || rst) begin
-          prd <= hmem[pa];
-          qrd <= HAS_B ? hmem[qa] : {DATA_W{1'b0}};  // a lone last section needs no x2 port
+          prd <= hmem[{pa[3] | rst, pa[2:0]}];
+          qrd <= HAS_B ? hmem[{qa[3] | rst, qa[2:0]}] : {DATA_W{1'b0}};  // a lone last section needs no x2 port
         end
         if (rst) begin
           wp_a <= 2'd0; wp_b <= 2'd0; vd_a <= 3'd0; vd_b <= 3'd0;
