@@ -9,11 +9,17 @@ namespace ranging {
 namespace {
 
 template <class T>
-void best_two(std::span<const T> q, int& best, T& second) {
-  best = 0;
+int argmax(std::span<const T> q) {  // the first of the largest
+  int best = 0;
   for (int j = 1; j < static_cast<int>(q.size()); ++j) {
     if (q[j] > q[best]) best = j;
   }
+  return best;
+}
+
+template <class T>
+void best_two(std::span<const T> q, int& best, T& second) {
+  best = argmax(q);
   second = T{};
   for (int j = 0; j < static_cast<int>(q.size()); ++j) {
     if (j != best && q[j] > second) second = q[j];
@@ -107,6 +113,13 @@ std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank)
 
 std::optional<Event> PeakDetectorFloat::execute(std::span<const double> q, std::int64_t n, double energy) {
   if (prev_.empty()) prev_.assign(q.size(), 0.0);
+  if (!cand_) {  // no candidate (most outputs): a closed gate changes nothing but prev_
+    const double top = q[static_cast<std::size_t>(argmax(q))];
+    if (!((energy > 0 ? top / energy : 0.0) >= cfg_.threshold && energy >= cfg_.min_energy)) {
+      prev_.assign(q.begin(), q.end());
+      return std::nullopt;
+    }
+  }
   int best;
   double second;
   best_two(q, best, second);
@@ -168,6 +181,14 @@ std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& 
 std::optional<EventFixed> PeakDetectorFixed::execute(std::span<const std::uint64_t> q, std::int64_t n,
                                                      std::uint64_t norm) {
   if (prev_.empty()) prev_.assign(q.size(), 0);
+  if (!cand_) {  // no candidate (most outputs): a closed gate changes nothing but prev_
+    const std::uint64_t top = q[static_cast<std::size_t>(argmax(q))];
+    if (!(static_cast<uint128_t>(top) >= static_cast<uint128_t>(thr_q_) * std::max<std::uint64_t>(norm, 1) &&
+          norm >= min_norm_)) {
+      prev_.assign(q.begin(), q.end());
+      return std::nullopt;
+    }
+  }
   int best;
   std::uint64_t second;
   best_two(q, best, second);
