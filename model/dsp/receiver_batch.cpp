@@ -211,14 +211,7 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
   const auto chunk = [&](std::size_t n0, std::size_t n, const std::int64_t* const* src, const bool* open) {
     // Interleave: lane l's sample n0 + i at in[i].v[l].
     std::int64_t mn = 0, mx = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      for (int l = 0; l < kBatchLanes; ++l) {
-        const std::int64_t v = src[l][i];
-        k.in[i].v[l] = v;
-        mn = v < mn ? v : mn;
-        mx = v > mx ? v : mx;
-      }
-    }
+    batch::interleave_batch(src, k.in.data(), n, &mn, &mx);
     if (mn < in_lo || mx > in_hi) {  // the input range, once per chunk; the scalar check names the sample
       for (std::size_t l = 0; l < lanes; ++l) {
         if (open[l]) k.filter.check_input(streams[l].subspan(n0, n));
@@ -337,10 +330,7 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
   k.in.resize(kChunk);
   k.out.resize(kChunk);
   const auto chunk = [&](std::size_t n0, std::size_t n, const double* const* src, const bool* open) {
-    // Interleave, x = sample * gain.
-    for (std::size_t i = 0; i < n; ++i) {
-      for (int l = 0; l < kBatchLanes; ++l) k.in[i].v[l] = src[l][i] * gain;
-    }
+    batch::interleave_batch_float(src, gain, k.in.data(), n);  // in[i].v[l] = src[l][i] * gain
     batch::bandpass_batch_float(k.bp, k.in.data(), k.out.data(), n);
     if (filtered) {
       for (std::size_t l = 0; l < lanes; ++l) {

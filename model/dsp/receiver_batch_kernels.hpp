@@ -116,6 +116,13 @@ std::size_t bank_feed_batch_float(FloatBankBatch& s, const LanesF* in, std::size
 // True when this build has the kernels and the CPU runs them.
 bool batch_kernels_available();
 
+// Interleave: out[i].v[l] = src[l][i] * gain (one IEEE multiply, as the scalar receiver's
+// input scaling) for i < n and every lane l < kBatchLanes (src[l] has n readable values), by
+// 8 x 8 transposes.
+void interleave_batch_float(const double* const* src, double gain, LanesF* out, std::size_t n);
+// out[i].v[l] = src[l][i]; *lo and *hi become min(*lo, every value) and max(*hi, every value).
+void interleave_batch(const std::int64_t* const* src, Lanes* out, std::size_t n, std::int64_t* lo, std::int64_t* hi);
+
 // out[i] = the cascade of in[i] (input codes, in range: the caller checks) for i < n, per lane.
 void bandpass_batch(BandpassBatch& s, const Lanes* in, Lanes* out, std::size_t n);
 

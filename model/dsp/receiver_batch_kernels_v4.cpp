@@ -264,7 +264,80 @@ void decimated_output_float(FloatBankBatch& s) {
   }
 }
 
+// 8 x 8 transpose: r[l] holds lane l's 8 consecutive values; afterwards r[i] holds value i of
+// every lane (three stages of two-source shuffles: 1-, 2-, then 4-element blocks).
+template <class T>
+void transpose8(T (&r)[8]) {
+  typedef long long I __attribute__((vector_size(64)));
+  T a[8], b[8];
+  for (int k = 0; k < 8; k += 2) {
+    a[k] = __builtin_shuffle(r[k], r[k + 1], I{0, 8, 2, 10, 4, 12, 6, 14});
+    a[k + 1] = __builtin_shuffle(r[k], r[k + 1], I{1, 9, 3, 11, 5, 13, 7, 15});
+  }
+  for (int k = 0; k < 8; k += 4) {
+    for (int m = 0; m < 2; ++m) {
+      b[k + m] = __builtin_shuffle(a[k + m], a[k + m + 2], I{0, 1, 8, 9, 4, 5, 12, 13});
+      b[k + m + 2] = __builtin_shuffle(a[k + m], a[k + m + 2], I{2, 3, 10, 11, 6, 7, 14, 15});
+    }
+  }
+  for (int m = 0; m < 4; ++m) {
+    r[m] = __builtin_shuffle(b[m], b[m + 4], I{0, 1, 2, 3, 8, 9, 10, 11});
+    r[m + 4] = __builtin_shuffle(b[m], b[m + 4], I{4, 5, 6, 7, 12, 13, 14, 15});
+  }
+}
+
+template <class T, class E>
+T load_unaligned(const E* p) {
+  T v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+
 }  // namespace
+
+void interleave_batch_float(const double* const* src, double gain, LanesF* out, std::size_t n) {
+  const D g = splatf(gain);
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    D r[8];
+    for (int l = 0; l < 8; ++l) r[l] = load_unaligned<D>(src[l] + i) * g;
+    transpose8(r);
+    for (int k = 0; k < 8; ++k) storef(out[i + k], r[k]);
+  }
+  for (; i < n; ++i) {
+    for (int l = 0; l < kBatchLanes; ++l) out[i].v[l] = src[l][i] * gain;
+  }
+}
+
+void interleave_batch(const std::int64_t* const* src, Lanes* out, std::size_t n, std::int64_t* lo, std::int64_t* hi) {
+  V mn = splat(*lo), mx = splat(*hi);
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    V r[8];
+    for (int l = 0; l < 8; ++l) {
+      r[l] = load_unaligned<V>(src[l] + i);
+      mn = r[l] < mn ? r[l] : mn;
+      mx = r[l] > mx ? r[l] : mx;
+    }
+    transpose8(r);
+    for (int k = 0; k < 8; ++k) store(out[i + k], r[k]);
+  }
+  std::int64_t a = *lo, b = *hi;
+  for (int l = 0; l < kBatchLanes; ++l) {
+    a = mn[l] < a ? mn[l] : a;
+    b = mx[l] > b ? mx[l] : b;
+  }
+  for (; i < n; ++i) {
+    for (int l = 0; l < kBatchLanes; ++l) {
+      const std::int64_t v = src[l][i];
+      out[i].v[l] = v;
+      a = v < a ? v : a;
+      b = v > b ? v : b;
+    }
+  }
+  *lo = a;
+  *hi = b;
+}
 
 void bandpass_batch_float(FloatBandpassBatch& s, const LanesF* in, LanesF* out, std::size_t n) {
   switch (s.sections) {
@@ -388,6 +461,8 @@ std::size_t bank_feed_batch_float(FloatBankBatch&, const LanesF*, std::size_t, b
 }
 
 bool batch_kernels_available() { return false; }
+void interleave_batch_float(const double* const*, double, LanesF*, std::size_t) {}
+void interleave_batch(const std::int64_t* const*, Lanes*, std::size_t, std::int64_t*, std::int64_t*) {}
 void bandpass_batch(BandpassBatch&, const Lanes*, Lanes*, std::size_t) {}
 std::size_t bank_feed_batch(BankBatch&, const Lanes*, std::size_t, bool* ready) {
   *ready = false;
