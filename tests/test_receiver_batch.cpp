@@ -13,6 +13,7 @@
 #include <cstring>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "model/base/error.hpp"
@@ -152,51 +153,89 @@ TEST(ReceiverBatch, RefusesAnOutOfRangeCodeAsTheScalarReceiverDoes) {
   EXPECT_THROW(rx.execute_block(streams[1], ev), InputError);
 }
 
+namespace {
+
 // ReceiverFloatBatch against ReceiverFloat per stream: the same events and every filtered
 // sample, bit for bit (memcmp of the doubles), with the input gain applied the same way.
+// Returns the number of events.
+std::size_t expect_float_same(const ReceiverDesign& d, const std::vector<std::vector<double>>& volts, double gain,
+                              const std::string& what) {
+  std::vector<std::span<const double>> spans(volts.begin(), volts.end());
+  ReceiverFloatBatch batch(d);
+  std::vector<std::vector<Event>> events;
+  std::vector<std::vector<double>> filtered;
+  batch.run(spans, gain, events, &filtered);
+  std::size_t detected = 0;
+  for (std::size_t s = 0; s < volts.size(); ++s) {
+    ReceiverFloat rx(d);
+    std::vector<double> x(volts[s].size()), f(volts[s].size());
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = volts[s][i] * gain;
+    std::vector<Event> want;
+    rx.execute_block(x, want, f);
+    if (auto e = rx.flush()) want.push_back(*e);
+    EXPECT_EQ(events[s].size(), want.size()) << what << " stream " << s;
+    for (std::size_t i = 0; i < std::min(want.size(), events[s].size()); ++i) {
+      EXPECT_EQ(events[s][i].code, want[i].code);
+      EXPECT_EQ(std::memcmp(&events[s][i].arrival, &want[i].arrival, sizeof(double)), 0) << what << " " << s;
+      EXPECT_EQ(std::memcmp(&events[s][i].score, &want[i].score, sizeof(double)), 0) << what << " " << s;
+      EXPECT_EQ(std::memcmp(&events[s][i].margin, &want[i].margin, sizeof(double)), 0) << what << " " << s;
+    }
+    EXPECT_EQ(filtered[s].size(), f.size());
+    if (!f.empty() && filtered[s].size() == f.size()) {  // (memcmp of an empty vector's null data is undefined)
+      EXPECT_EQ(std::memcmp(filtered[s].data(), f.data(), f.size() * sizeof(double)), 0) << what << " stream " << s;
+    }
+    detected += want.size();
+  }
+  std::printf("[ receiver batch ] float %s: %s path, %zu events\n", what.c_str(),
+              batch.vectorized() ? "AVX-512" : "scalar", detected);
+  return detected;
+}
+
+// volts: the codes' streams as doubles at an arbitrary scale, so the gain's rounding matters
+std::vector<std::vector<double>> make_volts(const ReceiverDesign& d, unsigned seed) {
+  std::vector<std::vector<double>> volts;
+  for (const auto& q : make_streams(d, mixed_lengths(d), seed)) {
+    std::vector<double> v;
+    for (auto c : q) v.push_back(0.037 * static_cast<double>(c) + 1e-7 * static_cast<double>(v.size() % 7));
+    volts.push_back(std::move(v));
+  }
+  return volts;
+}
+constexpr double kVoltsGain = 1.0 / (0.037 * 2048.0);
+
+}  // namespace
+
 TEST(ReceiverBatch, FloatMatchesTheScalarReceiverPerStreamBitForBit) {
   for (const char* family : {"Gold4", "M3"}) {
     ReceiverConfig cfg;
     cfg.family = family;
     fit_decimation_to_chip(cfg);
     const ReceiverDesign d = design_receiver(cfg);
-    // volts: the codes' streams as doubles at an arbitrary scale, so the gain's rounding matters
-    std::vector<std::vector<double>> volts;
-    for (const auto& q : make_streams(d, mixed_lengths(d), 13)) {
-      std::vector<double> v;
-      for (auto c : q) v.push_back(0.037 * static_cast<double>(c) + 1e-7 * static_cast<double>(v.size() % 7));
-      volts.push_back(std::move(v));
-    }
-    const double gain = 1.0 / (0.037 * 2048.0);
-    std::vector<std::span<const double>> spans(volts.begin(), volts.end());
-    ReceiverFloatBatch batch(d);
-    std::vector<std::vector<Event>> events;
-    std::vector<std::vector<double>> filtered;
-    batch.run(spans, gain, events, &filtered);
-    std::size_t detected = 0;
-    for (std::size_t s = 0; s < volts.size(); ++s) {
-      ReceiverFloat rx(d);
-      std::vector<double> x(volts[s].size()), f(volts[s].size());
-      for (std::size_t i = 0; i < x.size(); ++i) x[i] = volts[s][i] * gain;
-      std::vector<Event> want;
-      rx.execute_block(x, want, f);
-      if (auto e = rx.flush()) want.push_back(*e);
-      ASSERT_EQ(events[s].size(), want.size()) << family << " stream " << s;
-      for (std::size_t i = 0; i < want.size(); ++i) {
-        EXPECT_EQ(events[s][i].code, want[i].code);
-        EXPECT_EQ(std::memcmp(&events[s][i].arrival, &want[i].arrival, sizeof(double)), 0) << family << " " << s;
-        EXPECT_EQ(std::memcmp(&events[s][i].score, &want[i].score, sizeof(double)), 0) << family << " " << s;
-        EXPECT_EQ(std::memcmp(&events[s][i].margin, &want[i].margin, sizeof(double)), 0) << family << " " << s;
-      }
-      ASSERT_EQ(filtered[s].size(), f.size());
-      if (!f.empty()) {  // (memcmp of an empty vector's null data is undefined)
-        EXPECT_EQ(std::memcmp(filtered[s].data(), f.data(), f.size() * sizeof(double)), 0) << family << " stream " << s;
-      }
-      detected += want.size();
-    }
-    EXPECT_GT(detected, volts.size()) << family;
-    std::printf("[ receiver batch ] float %s: %s path\n", family, batch.vectorized() ? "AVX-512" : "scalar");
+    EXPECT_GT(expect_float_same(d, make_volts(d, 13), kVoltsGain, family), 11u) << family;
   }
+}
+
+// The batch calls a lane's detector only when its gate is open or a candidate is pending: the
+// gate (threshold on rho^2, min_energy on E) must be the detector's in every setting. A low
+// threshold opens it on noise, a high min_energy closes it on the quiet streams; both change
+// the events (asserted), and the batch must still match the scalar receiver.
+TEST(ReceiverBatch, FloatDetectorGateMatchesAtAnyThresholdAndMinimumEnergy) {
+  ReceiverConfig cfg;
+  const ReceiverDesign d0 = design_receiver(cfg);
+  const auto volts = make_volts(d0, 21);
+  const std::size_t base = expect_float_same(d0, volts, kVoltsGain, "default detector");
+  cfg.detector.threshold = 0.05;
+  const std::size_t low = expect_float_same(design_receiver(cfg), volts, kVoltsGain, "threshold 0.05");
+  // thresholds across the bursts' peaks: some peak just above one of them
+  for (double thr : {0.15, 0.25, 0.35, 0.45, 0.55, 0.65, 0.75, 0.85, 0.95}) {
+    cfg.detector.threshold = thr;
+    expect_float_same(design_receiver(cfg), volts, kVoltsGain, "threshold " + std::to_string(thr));
+  }
+  cfg.detector.threshold = ReceiverConfig{}.detector.threshold;
+  cfg.detector.min_energy = 2.0;
+  const std::size_t quiet = expect_float_same(design_receiver(cfg), volts, kVoltsGain, "min_energy 2");
+  EXPECT_NE(low, base);
+  EXPECT_NE(quiet, base);
 }
 
 // The bank's combiner saturations through the batch: a corr_shift 4 below the automatic one

@@ -113,25 +113,25 @@ std::optional<Event> PeakDetectorFloat::execute(const CorrelatorBankFloat& bank)
 
 std::optional<Event> PeakDetectorFloat::execute(std::span<const double> q, std::int64_t n, double energy) {
   if (prev_.empty()) prev_.assign(q.size(), 0.0);
-  if (!cand_) {  // no candidate (most outputs): a closed gate changes nothing but prev_
-    const double top = q[static_cast<std::size_t>(argmax(q))];
-    if (!((energy > 0 ? top / energy : 0.0) >= cfg_.threshold && energy >= cfg_.min_energy)) {
-      prev_.assign(q.begin(), q.end());
-      return std::nullopt;
-    }
-  }
+  auto out = execute(q, prev_, n, energy);
+  prev_.assign(q.begin(), q.end());
+  return out;
+}
+
+std::optional<Event> PeakDetectorFloat::execute(std::span<const double> q, std::span<const double> prev,
+                                                std::int64_t n, double energy) {
+  // no candidate (most outputs): a closed gate changes nothing
+  if (!cand_ && !gate(q[static_cast<std::size_t>(argmax(q))], energy)) return std::nullopt;
   int best;
   double second;
   best_two(q, best, second);
   take_right_neighbour(cand_, q);
   const double rho2 = energy > 0 ? q[static_cast<std::size_t>(best)] / energy : 0.0;  // CorrelatorBankFloat::rho2
-  const bool gate = rho2 >= cfg_.threshold && energy >= cfg_.min_energy;
   const double margin = rho2 - (energy > 0 ? second / energy : 0.0);
-  auto out = next_candidate(cand_, gate && (!cand_ || rho2 > cand_->score),
-                            Candidate{n, best, prev_[best], q[best], 0.0, rho2, margin, false}, n, holdoff_,
-                            [this](const Candidate& c) { return make_event(c); });
-  prev_.assign(q.begin(), q.end());
-  return out;
+  return next_candidate(cand_, gate(q[static_cast<std::size_t>(best)], energy) && (!cand_ || rho2 > cand_->score),
+                        Candidate{n, best, prev[static_cast<std::size_t>(best)], q[static_cast<std::size_t>(best)],
+                                  0.0, rho2, margin, false},
+                        n, holdoff_, [this](const Candidate& c) { return make_event(c); });
 }
 
 std::optional<Event> PeakDetectorFloat::flush() {

@@ -72,6 +72,16 @@ class PeakDetectorFloat {
   std::optional<Event> execute(const CorrelatorBankFloat& bank);
   // The same from a decimated output's values: Q_j per code, the full-rate sample index, E.
   std::optional<Event> execute(std::span<const double> q, std::int64_t n, double energy);
+  // The same with the previous output's Q_j given (zeros before the first output) instead of
+  // kept by the detector: its own record is neither read nor updated. A caller that knows the
+  // gate is closed while idle() skips the call (ReceiverFloatBatch): nothing would change.
+  std::optional<Event> execute(std::span<const double> q, std::span<const double> prev, std::int64_t n,
+                               double energy);
+  bool idle() const { return !cand_; }  // no candidate pending
+  // The gate of an output whose best code has Q = top: rho^2 = top / E >= threshold, E >= min_energy.
+  bool gate(double top, double energy) const {
+    return (energy > 0 ? top / energy : 0.0) >= cfg_.threshold && energy >= cfg_.min_energy;
+  }
   std::optional<Event> flush();  // end of stream: emit a pending candidate
 
  private:

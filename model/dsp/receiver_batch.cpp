@@ -326,7 +326,9 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
   const std::size_t lanes = streams.size();
   std::vector<PeakDetectorFloat> det(lanes, PeakDetectorFloat(design_.config.detector, design_.reference));
   const std::size_t codes = static_cast<std::size_t>(k.bank.codes);
-  std::vector<double> qv(codes);
+  std::vector<double> qv(codes), pv(codes);
+  std::vector<LanesF> qprev(codes);  // the previous output's Q_j (zeros before the first)
+  const double thr = design_.config.detector.threshold, min_e = design_.config.detector.min_energy;
   k.in.resize(kChunk);
   k.out.resize(kChunk);
   const auto chunk = [&](std::size_t n0, std::size_t n, const double* const* src, const bool* open) {
@@ -344,11 +346,18 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
       i += batch::bank_feed_batch_float(k.bank, k.out.data() + i, n - i, &ready);
       if (!ready) continue;
       const auto last = static_cast<std::int64_t>(n0 + i - 1);
+      // A lane's detector is called when its gate is open or it holds a candidate; otherwise
+      // the output changes nothing (PeakDetectorFloat::execute's own early return).
+      const unsigned gates = batch::gate_batch_float(k.bank, thr, min_e);
       for (std::size_t l = 0; l < lanes; ++l) {
-        if (!open[l]) continue;
-        for (std::size_t j = 0; j < codes; ++j) qv[j] = k.bank.q[j].v[l];
-        if (auto e = det[l].execute(qv, last, k.bank.energy.v[l])) events[l].push_back(*e);
+        if (!open[l] || (det[l].idle() && !((gates >> l) & 1u))) continue;
+        for (std::size_t j = 0; j < codes; ++j) {
+          qv[j] = k.bank.q[j].v[l];
+          pv[j] = qprev[j].v[l];
+        }
+        if (auto e = det[l].execute(qv, pv, last, k.bank.energy.v[l])) events[l].push_back(*e);
       }
+      std::copy(k.bank.q, k.bank.q + codes, qprev.begin());
     }
   };
   const auto finish = [&](std::size_t l) {

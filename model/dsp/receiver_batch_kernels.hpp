@@ -112,6 +112,10 @@ struct FloatBankBatch {
 
 void bandpass_batch_float(FloatBandpassBatch& s, const LanesF* in, LanesF* out, std::size_t n);
 std::size_t bank_feed_batch_float(FloatBankBatch& s, const LanesF* in, std::size_t n, bool* ready);
+// PeakDetectorFloat::gate of the decimated output in s.q / s.energy, lane by lane: bit l is set
+// when (E > 0 ? top / E : 0) >= threshold and E >= min_energy, top = max_j Q_j (compared in
+// code order, as the detector's argmax).
+unsigned gate_batch_float(const FloatBankBatch& s, double threshold, double min_energy);
 
 // True when this build has the kernels and the CPU runs them.
 bool batch_kernels_available();

@@ -339,6 +339,20 @@ void interleave_batch(const std::int64_t* const* src, Lanes* out, std::size_t n,
   *hi = b;
 }
 
+unsigned gate_batch_float(const FloatBankBatch& s, double threshold, double min_energy) {
+  D top = loadf(s.q[0]);
+  for (int j = 1; j < s.codes; ++j) {
+    const D q = loadf(s.q[j]);
+    top = q > top ? q : top;
+  }
+  const D e = loadf(s.energy);
+  const D rho2 = e > 0 ? top / e : D{};
+  const auto open = (rho2 >= threshold) & (e >= min_energy);  // -1 where open
+  unsigned mask = 0;
+  for (int l = 0; l < kBatchLanes; ++l) mask |= (open[l] != 0 ? 1u : 0u) << l;
+  return mask;
+}
+
 void bandpass_batch_float(FloatBandpassBatch& s, const LanesF* in, LanesF* out, std::size_t n) {
   switch (s.sections) {
     case 1: return bandpass_kernel_float<1>(s, in, out, n);
@@ -461,6 +475,7 @@ std::size_t bank_feed_batch_float(FloatBankBatch&, const LanesF*, std::size_t, b
 }
 
 bool batch_kernels_available() { return false; }
+unsigned gate_batch_float(const FloatBankBatch&, double, double) { return ~0u; }
 void interleave_batch_float(const double* const*, double, LanesF*, std::size_t) {}
 void interleave_batch(const std::int64_t* const*, Lanes*, std::size_t, std::int64_t*, std::int64_t*) {}
 void bandpass_batch(BandpassBatch&, const Lanes*, Lanes*, std::size_t) {}
