@@ -11,8 +11,10 @@
 // own last sample), so a batch of streams of similar length wastes little.
 //
 // Where the work is: the bandpass cascade and the bank's full-rate front end and decimated
-// outputs run in receiver_batch_kernels_v4.cpp (AVX-512, 8 lanes of int64); the detector, a few
-// operations per decimated output, runs per lane. On a CPU without AVX-512, or a configuration
+// outputs run in receiver_batch_kernels_v4.cpp (AVX-512, 8 lanes of int64), and so does the
+// interleaving of the lanes' inputs (8 x 8 transposes); the detector, a few operations per
+// decimated output, runs per lane (the float batch calls a lane's detector only when the
+// lanes' gate kernel finds its gate open or the detector holds a candidate). On a CPU without AVX-512, or a configuration
 // the kernels do not cover (more than 8 bandpass sections), every stream runs the scalar
 // ReceiverFixed instead: the same results, slower. vectorized() says which.
 #include <cstdint>
