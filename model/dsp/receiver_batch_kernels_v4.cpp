@@ -346,10 +346,11 @@ unsigned gate_batch_float(const FloatBankBatch& s, double threshold, double min_
   }
   const D e = loadf(s.energy);
   const D rho2 = e > 0 ? top / e : D{};
-  const auto open = (rho2 >= threshold) & (e >= min_energy);  // -1 where open
-  unsigned mask = 0;
-  for (int l = 0; l < kBatchLanes; ++l) mask |= (open[l] != 0 ? 1u : 0u) << l;
-  return mask;
+  // rho2 >= threshold && e >= min_energy per lane, as a bit mask (ordered compares: false for
+  // NaN, as C's >=)
+  const __mmask8 open = _mm512_cmp_pd_mask(reinterpret_cast<__m512d>(rho2), _mm512_set1_pd(threshold), _CMP_GE_OQ) &
+                        _mm512_cmp_pd_mask(reinterpret_cast<__m512d>(e), _mm512_set1_pd(min_energy), _CMP_GE_OQ);
+  return open;
 }
 
 void bandpass_batch_float(FloatBandpassBatch& s, const LanesF* in, LanesF* out, std::size_t n) {
