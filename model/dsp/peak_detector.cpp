@@ -182,9 +182,7 @@ std::optional<EventFixed> PeakDetectorFixed::execute(std::span<const std::uint64
                                                      std::uint64_t norm) {
   if (prev_.empty()) prev_.assign(q.size(), 0);
   if (!cand_) {  // no candidate (most outputs): a closed gate changes nothing but prev_
-    const std::uint64_t top = q[static_cast<std::size_t>(argmax(q))];
-    if (!(static_cast<uint128_t>(top) >= static_cast<uint128_t>(thr_q_) * std::max<std::uint64_t>(norm, 1) &&
-          norm >= min_norm_)) {
+    if (!gate(q[static_cast<std::size_t>(argmax(q))], norm)) {
       prev_.assign(q.begin(), q.end());
       return std::nullopt;
     }
@@ -193,13 +191,11 @@ std::optional<EventFixed> PeakDetectorFixed::execute(std::span<const std::uint64
   std::uint64_t second;
   best_two(q, best, second);
   take_right_neighbour(cand_, q);
-  const bool gate = static_cast<uint128_t>(q[best]) >=
-                        static_cast<uint128_t>(thr_q_) * std::max<std::uint64_t>(norm, 1) &&
-                    norm >= min_norm_;
   // rho^2 of the best code beats the candidate's: Q / norm > Q_c / norm_c, cross-multiplied.
   const bool better = !cand_ || static_cast<uint128_t>(q[best]) * std::max<std::uint64_t>(cand_->norm, 1) >
                                     static_cast<uint128_t>(cand_->q) * std::max<std::uint64_t>(norm, 1);
-  auto out = next_candidate(cand_, gate && better, Candidate{n, best, prev_[best], q[best], 0, second, norm, false}, n,
+  auto out = next_candidate(cand_, gate(q[best], norm) && better,
+                            Candidate{n, best, prev_[best], q[best], 0, second, norm, false}, n,
                             holdoff_, [this](const Candidate& c) { return make_event(c); });
   prev_.assign(q.begin(), q.end());
   return out;

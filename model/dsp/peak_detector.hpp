@@ -26,6 +26,7 @@
 // sample); score = min(2^score_bits - 1, floor(Q / max(norm, 1))) and margin = score(best) -
 // score(second) are computed only at an event. The fraction is (Q_next - Q_prev) 2^frac_bits /
 // (2 den) truncated toward zero (parabolic_fraction), then multiplied by D.
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -139,6 +140,12 @@ class PeakDetectorFixed {
   EventFixed make_event(const Candidate& c) const;
   DetectorConfig cfg_;
   int score_bits_, decimation_;
+  // The gate of an output whose best code has Q = top: top >= threshold_q max(norm, 1) (rho^2
+  // against the threshold, cross-multiplied) and norm >= min_norm_q.
+  bool gate(std::uint64_t top, std::uint64_t norm) const {
+    return static_cast<uint128_t>(top) >= static_cast<uint128_t>(thr_q_) * std::max<std::uint64_t>(norm, 1) &&
+           norm >= min_norm_;
+  }
   std::uint64_t thr_q_, min_norm_;
   int holdoff_;
   std::vector<std::uint64_t> prev_;
