@@ -336,7 +336,9 @@ CorrelatorBankFixed::CorrelatorBankFixed(const CorrelatorReference& ref,
   mix_range_ = fx_range(mix_fmt_);
   chip_range_ = fx_range(chip_fmt_);
   corr_range_ = fx_range(corr_fmt_);
-  for (const auto& row : signs_) sign_flat_.insert(sign_flat_.end(), row.begin(), row.end());
+  for (const auto& row : signs_) {
+    for (int sg : row) sign_mask_.push_back(sg < 0 ? -1 : 0);
+  }
   taps_rev_.assign(layout_.taps_q.rbegin(), layout_.taps_q.rend());
   reset();
 }
@@ -470,12 +472,14 @@ void CorrelatorBankFixed::decimated_output() {
     gr[c] = f_re_[k];
     gi[c] = f_im_[k];
   }
-  const std::int64_t* sg = sign_flat_.data();
-  for (std::size_t j = 0; j < q_.size(); ++j, sg += chips) {
+  // s g as (g ^ m) - m with the sign's mask m (0: +g, -1: ~g + 1 = -g), exact for |g| < 2^62:
+  // adds instead of multiplies.
+  const std::int64_t* sm = sign_mask_.data();
+  for (std::size_t j = 0; j < q_.size(); ++j, sm += chips) {
     std::int64_t cre = 0, cim = 0;
     for (std::size_t c = 0; c < chips; ++c) {
-      cre += sg[c] * gr[c];
-      cim += sg[c] * gi[c];
+      cre += (gr[c] ^ sm[c]) - sm[c];
+      cim += (gi[c] ^ sm[c]) - sm[c];
     }
     comb_re_[j] = cre;
     comb_im_[j] = cim;

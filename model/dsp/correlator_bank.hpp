@@ -188,7 +188,7 @@ class CorrelatorBankFixed {
   CorrelatorFixedConfig cfg_;
   CorrelatorFixedLayout layout_;
   std::vector<std::vector<int>> signs_;
-  std::vector<std::int64_t> sign_flat_;     // signs_ row-major, codes x chips
+  std::vector<std::int64_t> sign_mask_;     // signs_ row-major, codes x chips, as masks: 0 for +1, -1 for -1
   std::vector<std::int64_t> taps_rev_;      // taps_q reversed: the FIR reads forward
   FixedFormat mix_fmt_, chip_fmt_, corr_fmt_;
   FxRange mix_range_, chip_range_, corr_range_;
