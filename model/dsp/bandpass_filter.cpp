@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
 #include "model/base/error.hpp"
+#include "model/dsp/receiver_batch_kernels.hpp"
 #include "model/dsp/quantize.hpp"
 
 namespace ranging {
@@ -218,23 +220,149 @@ void float_kernel(const double* in, double* out, std::size_t len, const std::vec
   for (int k = 0; k < S; ++k) st[k] = {x1[k], x2[k], y1[k], y2[k]};
 }
 
+void float_dispatch(const double* in, double* out, std::size_t len, const std::vector<Biquad>& c,
+                    std::vector<BandpassFloat::State>& st) {
+  switch (c.size()) {
+    case 1: return float_kernel<1>(in, out, len, c, st);
+    case 2: return float_kernel<2>(in, out, len, c, st);
+    case 3: return float_kernel<3>(in, out, len, c, st);
+    case 4: return float_kernel<4>(in, out, len, c, st);
+    case 5: return float_kernel<5>(in, out, len, c, st);
+    case 6: return float_kernel<6>(in, out, len, c, st);
+    case 7: return float_kernel<7>(in, out, len, c, st);
+    default: return float_kernel<8>(in, out, len, c, st);
+  }
+}
+
+// ---- time split: one long block on the SIMD lanes ------------------------------------------
+//
+// A block of n >= kSplitMin samples is cut into kBatchLanes segments that run in lockstep on
+// the lanes of the SIMD-across-streams kernels (receiver_batch_kernels.hpp, the very arithmetic
+// of the scalar kernels, bit for bit). Lane 0 starts at sample 0 from the filter's state; lane
+// l >= 1 starts kSplitWarmup samples before its segment, from the zero state, and its outputs
+// count only from the segment's first sample b_l on. The cascade is stable, so the warm-up lane
+// forgets its start: in practice its state at b_l is already, bit for bit, the true one (the
+// state after sample b_l - 1 of the plain run). That is checked, never assumed: the true state
+// at b_l is lane l-1's final state (itself checked), and a lane whose state at b_l differs is
+// recomputed by the scalar kernel from the true state. So the output, the final state and the
+// overflow counts are those of the plain loop in every case; only the time depends on the data.
+// The warm-up costs kSplitWarmup / segment (at most 1/4) of the work.
+constexpr std::size_t kSplitWarmup = 16384;
+constexpr std::size_t kSplitLanes = batch::kBatchLanes;
+constexpr std::size_t kSplitMin = kSplitWarmup + kSplitLanes * 4 * kSplitWarmup;
+constexpr std::size_t kSplitStep = 2048;  // lockstep samples interleaved at a time
+static_assert(kSplitMin == kBandpassSplitMin);
+
+bool ranges_overlap(const void* a, const void* b, std::size_t bytes) {
+  const auto x = reinterpret_cast<std::uintptr_t>(a), y = reinterpret_cast<std::uintptr_t>(b);
+  return x < y + bytes && y < x + bytes;
+}
+
+// The states are plain structs of four 64-bit words: equal means the same bits (a -0.0 is not
+// taken for a +0.0, a NaN is itself).
+template <class St>
+bool same_state(const std::vector<St>& a, const std::vector<St>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(St)) == 0;
+}
+
+// Ops: set_lane(l, state), get_lane(l) -> state, interleave(src, lanes, m), run(in, out, m),
+// snapshot() (overflow counts at the end of the warm-up), commit(l) (lane l's counts of its
+// own outputs into the filter's counters) and scalar(in, out, m, state) (the plain kernel,
+// counting into the filter's counters). Returns how many lanes were recomputed.
+template <class T, class St, class LaneT, class Ops>
+std::size_t time_split(const T* in, T* out, std::size_t n, std::vector<St>& state, Ops& ops) {
+  constexpr std::size_t L = kSplitLanes, W = kSplitWarmup;
+  const std::size_t seg = (n - W) / L, steps = W + seg;
+  const T* src[L];
+  for (std::size_t l = 0; l < L; ++l) src[l] = in + l * seg;  // lane l's first input (b_l - W for l >= 1)
+  const std::vector<St> zero(state.size(), St{});
+  ops.set_lane(0, state);
+  for (std::size_t l = 1; l < L; ++l) ops.set_lane(l, zero);
+  std::vector<std::vector<St>> at_b(L);  // lane l's state at b_l
+  std::vector<LaneT> ib(kSplitStep), ob(kSplitStep);
+  for (std::size_t t0 = 0; t0 < steps;) {
+    const std::size_t m = std::min(kSplitStep, (t0 < W ? W : steps) - t0);
+    const T* p[L];
+    for (std::size_t l = 0; l < L; ++l) p[l] = src[l] + t0;
+    ops.interleave(p, ib.data(), m);
+    ops.run(ib.data(), ob.data(), m);
+    for (std::size_t l = 0; l < L; ++l) {
+      if (l > 0 && t0 < W) continue;  // a warm-up output
+      T* o = out + l * seg + t0;
+      for (std::size_t i = 0; i < m; ++i) o[i] = ob[i].v[l];
+    }
+    t0 += m;
+    if (t0 == W) {
+      for (std::size_t l = 1; l < L; ++l) at_b[l] = ops.get_lane(l);
+      ops.snapshot();
+    }
+  }
+  std::vector<St> truth = ops.get_lane(0);  // the state at b_1: lane 0 ran from the true state
+  ops.commit(0);
+  std::size_t redone = 0;
+  for (std::size_t l = 1; l < L; ++l) {
+    const std::size_t b = l * seg + W;
+    if (same_state(at_b[l], truth)) {
+      truth = ops.get_lane(l);
+      ops.commit(l);
+    } else {
+      ++redone;
+      ops.scalar(in + b, out + b, seg, truth);
+    }
+  }
+  const std::size_t done = L * seg + W;
+  if (done < n) ops.scalar(in + done, out + done, n - done, truth);
+  state = std::move(truth);
+  return redone;
+}
+
+// The float cascade on the lanes: batch::bandpass_batch_float (BandpassFloat's expression).
+struct FloatSplitOps {
+  using St = BandpassFloat::State;
+  const std::vector<Biquad>& c;
+  batch::FloatBandpassBatch b;
+  explicit FloatSplitOps(const std::vector<Biquad>& sections) : c(sections) {
+    b.sections = static_cast<int>(c.size());
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      const double v[5] = {c[k].b0, c[k].b1, c[k].b2, c[k].a1, c[k].a2};
+      for (int i = 0; i < 5; ++i) b.coef[k][i] = v[i];
+    }
+  }
+  void set_lane(std::size_t l, const std::vector<St>& s) {
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      b.x1[k].v[l] = s[k].x1, b.x2[k].v[l] = s[k].x2, b.y1[k].v[l] = s[k].y1, b.y2[k].v[l] = s[k].y2;
+    }
+  }
+  std::vector<St> get_lane(std::size_t l) const {
+    std::vector<St> s(c.size());
+    for (std::size_t k = 0; k < s.size(); ++k) s[k] = {b.x1[k].v[l], b.x2[k].v[l], b.y1[k].v[l], b.y2[k].v[l]};
+    return s;
+  }
+  void interleave(const double* const* src, batch::LanesF* o, std::size_t m) {
+    batch::interleave_batch_float(src, 1.0, o, m);  // x * 1.0 == x, bit for bit
+  }
+  void run(const batch::LanesF* i, batch::LanesF* o, std::size_t m) { batch::bandpass_batch_float(b, i, o, m); }
+  void snapshot() {}
+  void commit(std::size_t) {}
+  void scalar(const double* i, double* o, std::size_t m, std::vector<St>& s) { float_dispatch(i, o, m, c, s); }
+};
+
 }  // namespace
 
 void BandpassFloat::execute_block(std::span<const double> in, std::span<double> out) {
   if (in.size() != out.size()) throw InputError("BandpassFloat::execute_block: input and output sizes differ");
   if (in.empty()) return;
-  switch (sections_.size()) {
-    case 1: float_kernel<1>(in.data(), out.data(), in.size(), sections_, state_); break;
-    case 2: float_kernel<2>(in.data(), out.data(), in.size(), sections_, state_); break;
-    case 3: float_kernel<3>(in.data(), out.data(), in.size(), sections_, state_); break;
-    case 4: float_kernel<4>(in.data(), out.data(), in.size(), sections_, state_); break;
-    case 5: float_kernel<5>(in.data(), out.data(), in.size(), sections_, state_); break;
-    case 6: float_kernel<6>(in.data(), out.data(), in.size(), sections_, state_); break;
-    case 7: float_kernel<7>(in.data(), out.data(), in.size(), sections_, state_); break;
-    case 8: float_kernel<8>(in.data(), out.data(), in.size(), sections_, state_); break;
-    default:
-      for (std::size_t i = 0; i < in.size(); ++i) out[i] = execute(in[i]);
-      return;
+  if (sections_.size() > static_cast<std::size_t>(batch::kBatchMaxSections)) {
+    for (std::size_t i = 0; i < in.size(); ++i) out[i] = execute(in[i]);
+    return;
+  }
+  if (in.size() >= kSplitMin && !ranges_overlap(in.data(), out.data(), in.size() * sizeof(double)) &&
+      batch::batch_kernels_available()) {
+    FloatSplitOps ops(sections_);
+    split_.recomputed += time_split<double, State, batch::LanesF>(in.data(), out.data(), in.size(), state_, ops);
+    ++split_.blocks;
+  } else {
+    float_dispatch(in.data(), out.data(), in.size(), sections_, state_);
   }
   for (std::size_t k = 0; k < sections_.size(); ++k) out_[k] = state_[k].y1;  // the last sample's
 }
@@ -384,6 +512,64 @@ void bandpass_dispatch_sections(const std::int64_t* in, std::int64_t* out, std::
 #undef RANGING_BP_CASE
 }
 
+// The fixed cascade on the lanes: batch::bandpass_batch (BandpassFixed's arithmetic, exact
+// integers, the same rounding and overflow, counted per lane). St: BandpassFixed::State.
+template <class St>
+struct FixedSplitOps {
+  const std::vector<std::vector<std::int64_t>>& coef;
+  const BandpassFixedConfig& cfg;
+  std::int64_t in_scale;
+  FxRange range;
+  bool bias, sym;
+  OverflowCounter& target;  // the filter's section counters
+  batch::BandpassBatch b;
+  OverflowCounter ev[batch::kBatchLanes] = {}, snap[batch::kBatchLanes] = {};
+  FixedSplitOps(const std::vector<std::vector<std::int64_t>>& c, const BandpassFixedConfig& config, int input_shift,
+                const FxRange& r, bool bias_ok, bool sym_ok, OverflowCounter& counter)
+      : coef(c), cfg(config), in_scale(std::int64_t{1} << input_shift), range(r), bias(bias_ok), sym(sym_ok),
+        target(counter) {
+    b.sections = static_cast<int>(c.size());
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      for (int i = 0; i < 5; ++i) b.coef[k][i] = c[k][static_cast<std::size_t>(i)];
+    }
+    b.input_shift = input_shift;
+    b.qshift = cfg.coef_frac;
+    b.rounding = cfg.rounding;
+    b.overflow = cfg.overflow;
+    b.range = r;
+    // 32 x 32 -> 64 multiplies when every factor fits int32 (as ReceiverFixedBatch decides)
+    b.narrow = cfg.coef_bits <= 32 && cfg.data_bits <= 31 && cfg.data_frac <= 29;
+    b.sym = sym_ok;
+    b.events = ev;
+  }
+  void set_lane(std::size_t l, const std::vector<St>& s) {
+    b.x1.v[l] = s[0].x1;
+    b.x2.v[l] = s[0].x2;
+    for (std::size_t k = 0; k < s.size(); ++k) b.y1[k].v[l] = s[k].y1, b.y2[k].v[l] = s[k].y2;
+  }
+  std::vector<St> get_lane(std::size_t l) const {  // the scalar kernel's layout of the state
+    std::vector<St> s(coef.size());
+    s[0] = St{b.x1.v[l], b.x2.v[l], b.y1[0].v[l], b.y2[0].v[l]};
+    for (std::size_t k = 1; k < s.size(); ++k) s[k] = St{b.y1[k - 1].v[l], b.y2[k - 1].v[l], b.y1[k].v[l], b.y2[k].v[l]};
+    return s;
+  }
+  void interleave(const std::int64_t* const* src, batch::Lanes* o, std::size_t m) {
+    std::int64_t lo = 0, hi = 0;  // the caller checked the range
+    batch::interleave_batch(src, o, m, &lo, &hi);
+  }
+  void run(const batch::Lanes* i, batch::Lanes* o, std::size_t m) { batch::bandpass_batch(b, i, o, m); }
+  void snapshot() { std::copy(std::begin(ev), std::end(ev), std::begin(snap)); }
+  void commit(std::size_t l) {
+    target.saturations += ev[l].saturations - (l ? snap[l].saturations : 0);
+    target.wraps += ev[l].wraps - (l ? snap[l].wraps : 0);
+  }
+  void scalar(const std::int64_t* i, std::int64_t* o, std::size_t m, std::vector<St>& s) {
+    fx_dispatch(cfg.rounding, cfg.overflow, [&]<Rounding R, Overflow O>() {
+      bandpass_dispatch_sections<R, O>(i, o, m, in_scale, coef, s, cfg.coef_frac, range, target, bias, sym);
+    });
+  }
+};
+
 }  // namespace
 
 void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<std::int64_t> out) {
@@ -395,6 +581,14 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
   check_input(in);  // once per block
   const std::int64_t in_scale = std::int64_t{1} << input_shift_;
   const int qshift = config_.coef_frac;  // acc_frac - data_frac
+  if (coef_.size() <= static_cast<std::size_t>(batch::kBatchMaxSections) && in.size() >= kSplitMin &&
+      !ranges_overlap(in.data(), out.data(), in.size() * sizeof(std::int64_t)) && batch::batch_kernels_available()) {
+    FixedSplitOps<State> ops(coef_, config_, input_shift_, data_range_, bias_ok_, sym_ok_, section_events_);
+    split_.recomputed += time_split<std::int64_t, State, batch::Lanes>(in.data(), out.data(), in.size(), state_, ops);
+    ++split_.blocks;
+    for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
+    return;
+  }
   fx_dispatch(config_.rounding, config_.overflow, [&]<Rounding R, Overflow O>() {
     bandpass_dispatch_sections<R, O>(in.data(), out.data(), in.size(), in_scale, coef_, state_, qshift, data_range_,
                                      section_events_, bias_ok_, sym_ok_);

@@ -69,6 +69,17 @@ struct BandpassHeadroom {
 };
 BandpassHeadroom bandpass_headroom(const BandpassFixedConfig& config, const SosFilter& filter);
 
+// Long blocks (>= 540672 samples, when the CPU has AVX-512) run as 8 segments in lockstep on
+// SIMD lanes, each lane after the first starting 16384 samples early from the zero state; a
+// lane whose state at its segment's start is not bit for bit the true one is recomputed by the
+// scalar kernel (bandpass_filter.cpp, "time split"). Results never depend on it; the counts say
+// how often it ran and how often a lane had to be redone (that costs time only).
+inline constexpr std::size_t kBandpassSplitMin = 540672;  // the shortest block split (16384 + 8 * 65536)
+struct BandpassSplitStats {
+  std::size_t blocks = 0;      // blocks that ran on the lanes
+  std::size_t recomputed = 0;  // lanes recomputed by the scalar kernel
+};
+
 class BandpassFilter {  // same API for every precision
  public:
   virtual ~BandpassFilter();
@@ -86,9 +97,11 @@ class BandpassFloat final : public BandpassFilter {
   // Block form: out[i] = execute(in[i]) for every i, bit for bit (the same expression per
   // section, in the same order; section_outputs() then holds the last sample's). The state
   // lives in locals for the block (specialized for 1..8 sections), so the out-of-order core
-  // overlaps the sections' recursions. Sizes must match (InputError); in and out may alias.
+  // overlaps the sections' recursions. Sizes must match (InputError); in and out may alias
+  // (an aliased block never takes the time split: its recomputation needs the input).
   void execute_block(std::span<const double> in, std::span<double> out);
   const std::vector<double>& section_outputs() const { return out_; }
+  BandpassSplitStats split_stats() const { return split_; }  // since construction
 
   struct State {
     double x1 = 0, x2 = 0, y1 = 0, y2 = 0;
@@ -98,6 +111,7 @@ class BandpassFloat final : public BandpassFilter {
   std::vector<Biquad> sections_;
   std::vector<State> state_;
   std::vector<double> out_;
+  BandpassSplitStats split_;
 };
 
 class BandpassFixed final : public BandpassFilter {
@@ -116,7 +130,8 @@ class BandpassFixed final : public BandpassFilter {
   // sample is processed (the state is left as it was). Sizes must match (InputError).
   // Kernel: sample-major with every section's state in registers (specialized per section
   // count 1..8, rounding and overflow at compile time), so the out-of-order core overlaps
-  // the sections' recursions.
+  // the sections' recursions; a long block that does not alias takes the time split
+  // (BandpassSplitStats above).
   using BandpassFilter::execute_block;
   void execute_block(std::span<const std::int64_t> in, std::span<std::int64_t> out);
   // Throws InputError naming the first sample of `in` outside the signed input_bits range.
@@ -126,6 +141,7 @@ class BandpassFixed final : public BandpassFilter {
   const std::vector<std::int64_t>& section_outputs() const { return out_; }  // last sample, per section
   const std::vector<std::vector<std::int64_t>>& coefficients() const { return coef_; }  // {b0,b1,b2,a1,a2}
   OverflowCounter overflow_events() const { return section_events_; }  // section outputs
+  BandpassSplitStats split_stats() const { return split_; }  // since construction
   OverflowCounter input_overflow_events() const { return input_events_; }  // execute(double)
   const BandpassFixedConfig& config() const { return config_; }
   FixedFormat input_format() const { return input_fmt_; }
@@ -149,6 +165,7 @@ class BandpassFixed final : public BandpassFilter {
   bool bias_ok_ = false;
   bool sym_ok_ = false;   // every numerator is b0 [1, 0, -1]: one multiply (see .cpp)  // the RoundHalfUp kernel may fold its rounding constant (see .cpp)
   OverflowCounter section_events_, input_events_;
+  BandpassSplitStats split_;
   [[noreturn]] void throw_input_range(std::int64_t x_in) const;
 };
 

@@ -251,11 +251,17 @@ std::size_t ReceiverFloat::execute_block(std::span<const double> x, std::vector<
   if (!filtered.empty() && filtered.size() != x.size()) {
     throw InputError("ReceiverFloat::execute_block: filtered output size differs from the input's");
   }
+  // Short chunks stay in the cache; a long block is filtered in long chunks, which the
+  // bandpass runs on its SIMD lanes (BandpassSplitStats), into `filtered` when given.
   constexpr std::size_t kChunk = 4096;
-  double y[kChunk];
+  const bool split = x.size() >= kBandpassSplitMin;
+  const std::size_t chunk = split ? std::min(x.size(), 2 * kBandpassSplitMin) : kChunk;
+  double y_small[kChunk];
+  if (split && filtered.empty()) long_chunk_.resize(chunk);
   const std::size_t before = events.size();
-  for (std::size_t n0 = 0; n0 < x.size(); n0 += kChunk) {
-    const std::size_t len = std::min(kChunk, x.size() - n0);
+  for (std::size_t n0 = 0; n0 < x.size(); n0 += chunk) {
+    const std::size_t len = std::min(chunk, x.size() - n0);
+    double* y = !filtered.empty() ? filtered.data() + n0 : split ? long_chunk_.data() : y_small;
     filter_.execute_block(x.subspan(n0, len), std::span<double>(y, len));
     for (std::span<const double> rest(y, len); !rest.empty();) {
       rest = rest.subspan(bank_.feed(rest));
@@ -263,7 +269,6 @@ std::size_t ReceiverFloat::execute_block(std::span<const double> x, std::vector<
         if (auto e = detector_.execute(bank_)) events.push_back(*e);
       }
     }
-    if (!filtered.empty()) std::copy(y, y + len, filtered.begin() + static_cast<std::ptrdiff_t>(n0));
     filtered_ = y[len - 1];
   }
   return events.size() - before;
@@ -292,11 +297,13 @@ std::optional<EventFixed> ReceiverFixed::execute_raw(std::int64_t x) {
 }
 
 std::size_t ReceiverFixed::execute_block(std::span<const std::int64_t> x, std::vector<EventFixed>& events) {
-  constexpr std::size_t kChunk = 1024;
+  // Short chunks stay in the cache; a long block is filtered in long chunks, which the
+  // bandpass runs on its SIMD lanes (BandpassSplitStats).
+  const std::size_t chunk = x.size() >= kBandpassSplitMin ? std::min(x.size(), 2 * kBandpassSplitMin) : 1024;
   const std::size_t before = events.size();
-  chunk_.resize(kChunk);
+  if (chunk_.size() < chunk) chunk_.resize(chunk);
   while (!x.empty()) {
-    const std::size_t n = std::min(kChunk, x.size());
+    const std::size_t n = std::min(chunk, x.size());
     const std::span<std::int64_t> y(chunk_.data(), n);
     filter_.execute_block(x.first(n), y);
     std::span<const std::int64_t> rest(y);

@@ -118,6 +118,7 @@ class ReceiverFloat {
 
  private:
   BandpassFloat filter_;
+  std::vector<double> long_chunk_;  // execute_block's filtered long chunk
   CorrelatorBankFloat bank_;
   PeakDetectorFloat detector_;
   double filtered_ = 0;

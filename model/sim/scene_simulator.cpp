@@ -1157,8 +1157,10 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     if (fixed) {
       bp.execute_block(std::span<const double>(x.data(), k), wk);
     } else {
-      for (std::size_t i = 0; i < k; ++i) wk[i] = x[i] * inv;
-      bp.execute_block(wk, wk);
+      // scaled in place in x (read again next block), so the filter's input and output do not
+      // alias: a long block then runs on the SIMD lanes (BandpassSplitStats)
+      for (std::size_t i = 0; i < k; ++i) x[i] *= inv;
+      bp.execute_block(std::span<const double>(x.data(), k), wk);
       for (double& v : wk) v *= scale;
     }
     const long avail = base + static_cast<long>(w.size());
