@@ -281,6 +281,17 @@ Duration duration_td(std::span<const double> x, double fs) {
   return {first, last, static_cast<double>(last - first) / fs};
 }
 
+namespace {
+// max(0, |x[i]|) over [a, b), NaN skipped (std::max's order). Not inlined: in the caller, whose
+// result's address goes to require_finite, GCC kept the running maximum in memory (a store and
+// a reload per sample).
+[[gnu::noinline]] double max_abs(const double* x, std::size_t a, std::size_t b) {
+  double m = 0;
+  for (std::size_t i = a; i < b; ++i) m = std::max(m, std::abs(x[i]));
+  return m;
+}
+}  // namespace
+
 StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std::size_t hi, std::size_t p0,
                                   std::size_t p1, std::size_t guard, double fs) {
   require_in_range("fs", fs, 1e-9, 1e12);
@@ -289,15 +300,14 @@ StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std
                      std::to_string(p0) + ", " + std::to_string(p1) + ") must be non-empty and inside the " +
                      std::to_string(x.size()) + "-sample stream");
   }
-  double b = 0;
-  for (std::size_t i = p0; i < p1; ++i) b = std::max(b, std::abs(x[i]));
+  const double b = max_abs(x.data(), p0, p1);
   require_finite("duration_td_stream: peak |x|", b);
   if (b == 0.0) throw InputError("duration_td_stream: burst window is all zero; T_d needs a non-zero peak");
   StreamDuration d;
   const std::size_t n0 = lo > 2000 ? lo - 2000 : 0;
   if (lo - n0 >= 100) {
-    std::vector<double> m;
-    for (std::size_t i = n0; i < lo; ++i) m.push_back(std::abs(x[i]));
+    std::vector<double> m(lo - n0);
+    for (std::size_t i = n0; i < lo; ++i) m[i - n0] = std::abs(x[i]);
     std::nth_element(m.begin(), m.begin() + static_cast<long>(m.size() / 2), m.end());
     d.noise_rms = m[m.size() / 2] / 0.6744897501960817;
   }
@@ -308,8 +318,9 @@ StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std
   }
   // The burst's peak, then outwards until `guard` consecutive samples are at or below a.
   std::size_t pk = p0;
+  double top = std::abs(x[p0]);  // |x[pk]|
   for (std::size_t i = p0; i < p1; ++i) {
-    if (std::abs(x[i]) > std::abs(x[pk])) pk = i;
+    if (const double a = std::abs(x[i]); a > top) top = a, pk = i;
   }
   pk = std::clamp(pk, lo, hi - 1);
   const std::size_t gap = std::max<std::size_t>(guard, 1);
