@@ -225,11 +225,10 @@ std::vector<Sample> tiled(const std::vector<Sample>& v) {
   return t;
 }
 
-void BM_FixedReceiverLong(benchmark::State& state) {
-  const Setup& s = setup();
-  static const std::vector<std::int64_t> in = tiled(s.codes);
-  ReceiverFixed rx(s.d);
-  std::vector<EventFixed> ev;
+template <class Receiver, class EventT, class Sample>
+void long_stream(benchmark::State& state, const std::vector<Sample>& in) {
+  Receiver rx(setup().d);
+  std::vector<EventT> ev;
   for (auto _ : state) {
     rx.reset();
     ev.clear();
@@ -237,22 +236,20 @@ void BM_FixedReceiverLong(benchmark::State& state) {
     benchmark::DoNotOptimize(ev.data());
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(in.size()));
-  const auto st = rx.filter().split_stats();
-  state.SetLabel(std::to_string(st.blocks) + " split blocks, " + std::to_string(st.recomputed) + " lanes redone");
+  if constexpr (requires { rx.filter().split_stats(); }) {
+    const auto st = rx.filter().split_stats();
+    state.SetLabel(std::to_string(st.blocks) + " split blocks, " + std::to_string(st.recomputed) + " lanes redone");
+  }
+}
+
+void BM_FixedReceiverLong(benchmark::State& state) {
+  static const std::vector<std::int64_t> in = tiled(setup().codes);
+  long_stream<ReceiverFixed, EventFixed>(state, in);
 }
 
 void BM_FloatReceiverLong(benchmark::State& state) {
-  const Setup& s = setup();
-  static const std::vector<double> in = tiled(s.x);
-  ReceiverFloat rx(s.d);
-  std::vector<Event> ev;
-  for (auto _ : state) {
-    rx.reset();
-    ev.clear();
-    rx.execute_block(in, ev);
-    benchmark::DoNotOptimize(ev.data());
-  }
-  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(in.size()));
+  static const std::vector<double> in = tiled(setup().x);
+  long_stream<ReceiverFloat, Event>(state, in);
 }
 
 void BM_WhiteNoise(benchmark::State& state) {

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Every speed figure of issue 13 from one run (benchmarks, never pass/fail tests):
-#   the golden model per stage, fixed and float (bench/bench_model), MS/s and x real time, and
+#   the golden model per stage, fixed and float (bench/bench_model), MS/s and x real time (also
+#   one long stream, whose bandpass runs time-split on the SIMD lanes), and
 #     the fixed and float receivers on 8 streams at once (ReceiverFixedBatch / ReceiverFloatBatch,
 #     one stream per AVX-512 lane);
 #   the bandpass kernel vs scipy.signal.sosfilt on the same design and input
@@ -119,6 +120,12 @@ print(f"  8 streams at once ({label}: ReceiverFixedBatch, samples of all streams
       f"target >= 125 MS/s per core: {'met' if b8 >= 125e6 else 'NOT met'} with 8 streams, "
       f"{'met' if m['BM_FixedReceiver'] >= 125e6 else 'NOT met'} with one")
 print(f"  float / fixed receiver: {m['BM_FloatReceiver'] / m['BM_FixedReceiver']:.2f}")
+lab = {b["name"]: b.get("label", "") for b in json.load(open(f"{t}/model.json"))["benchmarks"]}
+row("fixed receiver, one long stream", m["BM_FixedReceiverLong"])
+row("float receiver, one long stream", m["BM_FloatReceiverLong"])
+print(f"  one 2 M-sample stream / the 23 k-sample input: fixed {m['BM_FixedReceiverLong'] / m['BM_FixedReceiver']:.2f}x, "
+      f"float {m['BM_FloatReceiverLong'] / m['BM_FloatReceiver']:.2f}x (bandpass time split: {lab['BM_FixedReceiverLong']}); "
+      f"target >= 125 MS/s: {'met' if m['BM_FixedReceiverLong'] >= 125e6 else 'NOT met'} on a long stream")
 print()
 print("Channel stages (bench_model, the same input):")
 row("white noise (Boost ziggurat)", m["BM_WhiteNoise"])
