@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <complex>
 #include <new>
 #include <limits>
@@ -115,6 +116,68 @@ PearsonBank::Plan& PearsonBank::plan(std::size_t nfft) {
   return *plans_.emplace(nfft, std::move(p)).first->second;
 }
 
+namespace {
+// Per lag k < lags of the window (prefix sums s1, s2 of x - mean): var_k = max(0, S2 - S1^2 / N)
+// over x[k, k + N); then den_k = sqrt(var_k), 0 where the window is flat (var_k <= 1e-24 of the
+// largest, or 0: rho = 0 there), inv_den_k = 1 / den_k (0 there). Every lag on its own, IEEE
+// operations only (divide, sqrt, max), so the AVX-512 clone (picked at load time on a CPU that
+// has it) gives the baseline's bits. metrics.cpp is built with -fno-math-errno, so sqrt is the
+// instruction (and vectorizes); the argument is never negative, errno was never set.
+#if defined(__x86_64__)
+#define RANGING_CLONE_V4 [[gnu::target_clones("default", "arch=x86-64-v4")]]
+#else
+#define RANGING_CLONE_V4
+#endif
+RANGING_CLONE_V4 void lag_norms(const double* s1, const double* s2, std::size_t n, std::size_t lags, double* den,
+                                double* inv_den) {
+  const auto nd = static_cast<double>(n);
+  for (std::size_t k = 0; k < lags; ++k) {
+    const double m1 = s1[k + n] - s1[k];
+    den[k] = std::max(0.0, (s2[k + n] - s2[k]) - m1 * m1 / nd);
+  }
+  // the largest variance: max is exact and the variances are not NaN, so any order gives it
+  double m8[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  std::size_t k = 0;
+  for (; k + 8 <= lags; k += 8) {
+    for (std::size_t u = 0; u < 8; ++u) m8[u] = std::max(m8[u], den[k + u]);
+  }
+  for (; k < lags; ++k) m8[0] = std::max(m8[0], den[k]);
+  double den_max = 0;
+  for (double v : m8) den_max = std::max(den_max, v);
+  const double floor = 1e-24 * den_max;
+  for (k = 0; k < lags; ++k) {
+    const double v = den[k];
+    const double d = v > floor && v > 0 ? std::sqrt(v) : 0.0;
+    den[k] = d;
+    inv_den[k] = d > 0 ? 1.0 / d : 0.0;
+  }
+}
+
+// g_k = o_k inv_den_k for k < lags, and the largest g (max is exact and the products are finite:
+// any order of the maximum gives it, so the AVX-512 clone gives the baseline's bits).
+// Eight running maxima in one vector (the compiler does not vectorize a max reduction itself).
+RANGING_CLONE_V4 double screen_products(const double* o, const double* inv_den, std::size_t lags, double* g) {
+  typedef double V8 __attribute__((vector_size(64)));
+  V8 m = V8{} - HUGE_VAL;
+  std::size_t k = 0;
+  for (; k + 8 <= lags; k += 8) {
+    V8 a, b;
+    std::memcpy(&a, o + k, sizeof a);
+    std::memcpy(&b, inv_den + k, sizeof b);
+    const V8 p = a * b;
+    std::memcpy(g + k, &p, sizeof p);
+    m = m < p ? p : m;  // std::max per lane
+  }
+  double gmax = -HUGE_VAL;
+  for (int u = 0; u < 8; ++u) gmax = std::max(gmax, m[u]);
+  for (; k < lags; ++k) {
+    g[k] = o[k] * inv_den[k];
+    gmax = std::max(gmax, g[k]);
+  }
+  return gmax;
+}
+}  // namespace
+
 std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long hi) {
   const auto [a, b] = valid_lags(x.size(), n_, lo, hi);
   const std::size_t lags = static_cast<std::size_t>(b - a) + 1;
@@ -133,23 +196,8 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     s1[i + 1] = s1[i] + v;
     s2[i + 1] = s2[i] + v * v;
   }
-  const auto nd = static_cast<double>(n_);
-  std::vector<double> den(lags);
-  double den_max = 0;
-  for (std::size_t k = 0; k < lags; ++k) {
-    const double m1 = s1[k + n_] - s1[k];
-    const double var = std::max(0.0, (s2[k + n_] - s2[k]) - m1 * m1 / nd);
-    den[k] = var;
-    den_max = std::max(den_max, var);
-  }
-  // Per lag, once for every template: den becomes sqrt(var) (0 where the window is flat: rho = 0
-  // there), inv_den its reciprocal (0 there) for the screening below.
-  std::vector<double> inv_den(lags);
-  for (std::size_t k = 0; k < lags; ++k) {
-    double& d = den[k];
-    d = d > 1e-24 * den_max && d > 0 ? std::sqrt(d) : 0.0;
-    inv_den[k] = d > 0 ? 1.0 / d : 0.0;
-  }
+  std::vector<double> den(lags), inv_den(lags), g(lags);
+  lag_norms(s1.data(), s2.data(), n_, lags, den.data(), inv_den.data());
   std::fill(p.in, p.in + nfft, 0.0);
   for (std::size_t i = 0; i < w; ++i) p.in[i] = xw[i] - mean;
   fftw_execute(p.fwd);
@@ -179,18 +227,12 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     // of the plain loop, bit for bit. If the largest rho is itself clamped at -1, every lag is.
     const double* o = p.out;
     const double g1 = tn / inv_nfft;  // g at rho = 1
-    double m4[4] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // four chains: no serial max
-    std::size_t k = 0;
-    for (; k + 4 <= lags; k += 4) {
-      for (std::size_t u = 0; u < 4; ++u) m4[u] = std::max(m4[u], o[k + u] * inv_den[k + u]);
-    }
-    for (; k < lags; ++k) m4[0] = std::max(m4[0], o[k] * inv_den[k]);
-    const double gmax = std::max(std::max(m4[0], m4[1]), std::max(m4[2], m4[3]));
+    const double gmax = screen_products(o, inv_den.data(), lags, g.data());
     const double lo = (screen_ && tn > 0 && gmax >= -g1 * (1 - 1e-9))
                           ? std::min(gmax, g1 * (1 - 1e-9)) - (std::abs(gmax) + g1) * 1e-12 - 1e-290
                           : -HUGE_VAL;
-    for (k = 0; k < lags; ++k) {
-      if (!(o[k] * inv_den[k] >= lo)) continue;
+    for (std::size_t k = 0; k < lags; ++k) {
+      if (!(g[k] >= lo)) continue;
       double r = 0;
       if (den[k] > 0 && tn > 0) r = std::clamp(o[k] * inv_nfft / (den[k] * tn), -1.0, 1.0);
       if (r > best.rho) best = {r, a + static_cast<long>(k)};
