@@ -11,7 +11,12 @@
 #include "tests/process.hpp"
 
 #include "model/base/error.hpp"
+#include "model/sim/fft.hpp"
 #include "model/sim/metrics.hpp"
+
+#include <fftw3.h>
+#include <complex>
+#include <cstring>
 
 using namespace ranging;
 
@@ -272,6 +277,79 @@ TEST(PearsonOverLags, ScreeningTheLagsGivesThePlainLoopsResultBitForBit) {
   EXPECT_NEAR(screened.search(rep, 3, 400)[0].rho, 1.0, 1e-12);
   EXPECT_EQ(screened.search(xs[1], 7, 300)[0].rho, 0.0);
   EXPECT_EQ(screened.search(xs[1], 7, 300)[0].lag, 7);
+}
+
+// The search's loops (lag norms, spectrum product, screening) run in AVX-512 clones on a CPU
+// that has them (metrics.cpp). Its results must be, bit for bit, this plain scalar computation
+// of the same algorithm (this file is built for the baseline ISA without contraction): a clone
+// that fused a product into a sum, or reordered a sum, fails it.
+TEST(PearsonOverLags, TheVectorLoopsGiveTheScalarAlgorithmsBits) {
+  std::vector<std::vector<double>> ts;
+  for (std::uint64_t j = 0; j < 3; ++j) ts.push_back(random_signal(203, 40 + j));
+  auto x = random_signal(1500, 9);
+  for (std::size_t i = 0; i < 203; ++i) x[611 + i] += 1.5 * ts[2][i];
+  PearsonBank bank(ts);
+  std::size_t checked = 0;
+  for (auto [lo, hi] : {std::pair<long, long>{0, 1297}, {400, 800}, {599, 627}, {3, 10}}) {
+    const auto got = bank.search(x, lo, hi);
+    // the same steps, scalar: centred window, prefix sums, per-lag norms, FFT correlation
+    const std::size_t n = ts[0].size(), lags = static_cast<std::size_t>(hi - lo) + 1, w = lags + n - 1;
+    const std::size_t nfft = std::max<std::size_t>(64, fft_size(w)), nc = nfft / 2 + 1;
+    const double* xw = x.data() + lo;
+    double mean = 0;
+    for (std::size_t i = 0; i < w; ++i) mean += xw[i];
+    mean /= static_cast<double>(w);
+    std::vector<double> s1(w + 1, 0.0), s2(w + 1, 0.0), den(lags), in(nfft, 0.0), out(nfft);
+    for (std::size_t i = 0; i < w; ++i) {
+      const double v = xw[i] - mean;
+      s1[i + 1] = s1[i] + v;
+      s2[i + 1] = s2[i] + v * v;
+      in[i] = v;
+    }
+    double den_max = 0;
+    for (std::size_t k = 0; k < lags; ++k) {
+      const double m1 = s1[k + n] - s1[k];
+      den[k] = std::max(0.0, (s2[k + n] - s2[k]) - m1 * m1 / static_cast<double>(n));
+      den_max = std::max(den_max, den[k]);
+    }
+    for (double& d : den) d = d > 1e-24 * den_max && d > 0 ? std::sqrt(d) : 0.0;
+    std::vector<std::complex<double>> xs(nc), prod(nc), tsp(nc);
+    fftw_plan fwd = fftw_plan_dft_r2c_1d(static_cast<int>(nfft), in.data(), reinterpret_cast<fftw_complex*>(xs.data()),
+                                         FFTW_ESTIMATE);
+    fftw_plan inv = fftw_plan_dft_c2r_1d(static_cast<int>(nfft), reinterpret_cast<fftw_complex*>(prod.data()),
+                                         out.data(), FFTW_ESTIMATE);
+    fftw_execute(fwd);
+    const std::vector<std::complex<double>> xspec = xs;
+    for (std::size_t j = 0; j < ts.size(); ++j) {
+      double m = 0, ss = 0;
+      for (double v : ts[j]) m += v;
+      m /= static_cast<double>(n);
+      std::fill(in.begin(), in.end(), 0.0);
+      for (std::size_t i = 0; i < n; ++i) in[i] = ts[j][i] - m, ss += in[i] * in[i];
+      fftw_execute(fwd);  // into xs
+      for (std::size_t i = 0; i < nc; ++i) tsp[i] = std::conj(xs[i]);
+      for (std::size_t i = 0; i < nc; ++i) {
+        const double ar = xspec[i].real(), ai = xspec[i].imag(), br = tsp[i].real(), bi = tsp[i].imag();
+        prod[i] = {ar * br - ai * bi, ar * bi + ai * br};
+      }
+      fftw_execute(inv);
+      const double tn = std::sqrt(ss), inv_nfft = 1.0 / static_cast<double>(nfft);
+      LagRho best{-2.0, lo};
+      for (std::size_t k = 0; k < lags; ++k) {
+        double r = 0;
+        if (den[k] > 0 && tn > 0) r = std::clamp(out[k] * inv_nfft / (den[k] * tn), -1.0, 1.0);
+        if (r > best.rho) best = {r, lo + static_cast<long>(k)};
+      }
+      EXPECT_EQ(got[j].lag, best.lag) << lo << " " << j;
+      EXPECT_EQ(std::memcmp(&got[j].rho, &best.rho, sizeof(double)), 0) << lo << " " << j << ": " << got[j].rho << " vs "
+                                                                         << best.rho;
+      ++checked;
+    }
+    fftw_destroy_plan(fwd);
+    fftw_destroy_plan(inv);
+  }
+  EXPECT_EQ(checked, 12u);
+  EXPECT_EQ(bank.search(x, 400, 800)[2].lag, 611);  // and the embedded template is found
 }
 
 TEST(PearsonOverLags, AgreesWithNumpyOracle) {
