@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -273,6 +274,40 @@ TEST(FlatTopClipping, CountsRunsAtTheExtremes) {
   EXPECT_GT(t.samples, 100u);
   EXPECT_EQ(t.runs, 32u);  // 16 cycles, one flat top and one flat bottom each
   EXPECT_EQ(flat_top_clipping(std::vector<double>(10, 0.0)).samples, 0u);
+}
+
+// The scan in blocks (decode streams the capture) counts what a plain count of the maximal runs
+// at the extremes finds, wherever the blocks cut the runs and however long the flat stretches
+// between them.
+TEST(FlatTopClipping, BlocksOfAnySizeCountThePlainRuns) {
+  std::mt19937_64 rng(5);
+  std::vector<double> x;
+  while (x.size() < 5000) {
+    const int kind = static_cast<int>(rng() % 4), len = 1 + static_cast<int>(rng() % 6);
+    for (int i = 0; i < (kind < 2 ? len : 1 + static_cast<int>(rng() % 200)); ++i) {
+      x.push_back(kind == 0 ? 0.75 : kind == 1 ? -0.5 : std::uniform_real_distribution<double>(-0.49, 0.74)(rng));
+    }
+  }
+  for (std::size_t min_run : {1u, 3u, 5u}) {
+    std::size_t samples = 0, runs = 0;  // the plain count
+    for (std::size_t i = 0; i < x.size();) {
+      std::size_t j = i;
+      while (j < x.size() && x[j] == x[i]) ++j;
+      if ((x[i] == 0.75 || x[i] == -0.5) && j - i >= min_run) samples += j - i, ++runs;
+      i = j;
+    }
+    ASSERT_GT(runs, 50u);
+    for (std::size_t block : {std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{64}, x.size()}) {
+      FlatTopScan scan(min_run);
+      for (std::size_t i = 0; i < x.size(); i += block) scan.levels(std::span(x).subspan(i, std::min(block, x.size() - i)));
+      for (std::size_t i = 0; i < x.size(); i += block) scan.runs(std::span(x).subspan(i, std::min(block, x.size() - i)));
+      const FlatTops t = scan.result();
+      EXPECT_EQ(t.samples, samples) << "min_run " << min_run << ", blocks of " << block;
+      EXPECT_EQ(t.runs, runs) << "min_run " << min_run << ", blocks of " << block;
+      EXPECT_EQ(t.high, 0.75);
+      EXPECT_EQ(t.low, -0.5);
+    }
+  }
 }
 
 // The tools never clip silently: simulate's text and JSON summaries and decode's output name it,

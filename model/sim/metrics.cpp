@@ -491,9 +491,18 @@ void FlatTopScan::runs(std::span<const double> x) {
     }
     run = 0;
   };
-  for (const double v : x) {
-    step(run_high_, v == t_.high);
-    if (t_.high != t_.low) step(run_low_, v == t_.low);
+  // Up to the first sample at either level every step is a "not at level": the first closes
+  // the runs in progress, the others find them closed (run 0 < min_run). So one such step
+  // stands for all of them, and most blocks (no flat top) cost one search.
+  const double hi = t_.high, lo = t_.low;
+  const auto first = std::find_if(x.begin(), x.end(), [&](double v) { return v == hi || v == lo; });
+  if (first != x.begin()) {
+    step(run_high_, false);
+    if (hi != lo) step(run_low_, false);
+  }
+  for (auto it = first; it != x.end(); ++it) {
+    step(run_high_, *it == hi);
+    if (hi != lo) step(run_low_, *it == lo);
   }
 }
 
