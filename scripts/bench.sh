@@ -141,6 +141,8 @@ print(f"Bandpass kernel ({sos['sections']} sections, 4096-sample 200 kHz sine), 
 print(f"  ours, bit-exact fixed (execute_raw per sample)  {k/1e6:8.2f}")
 print(f"  ours, bit-exact fixed (execute_block)           {f['BM_BandpassFixedBlock']/1e6:8.2f}")
 print(f"  ours, execute_block on the receiver's input     {m['BM_FixedBandpass']/1e6:8.2f}  (22953 samples)")
+flab = {b["name"]: b.get("label", "") for b in json.load(open(f"{t}/fixed.json"))["benchmarks"]}
+print(f"  ours, execute_block on 1 M samples              {f['BM_BandpassFixedBlock1M']/1e6:8.2f}  ({flab['BM_BandpassFixedBlock1M']})")
 print(f"  ranging::Fixed type                             {kt/1e6:8.2f}")
 print(f"  sc_fixed<16,2,SC_RND,SC_SAT>                    {sc/1e6:8.2f}")
 print(f"  sc_fix (runtime parameters)                     {scf/1e6:8.2f}")
@@ -148,6 +150,7 @@ print(f"  scipy.signal.sosfilt float64, 4096 samples      {s4/1e6:8.2f}")
 print(f"  scipy.signal.sosfilt float64, 1 M samples       {s1m/1e6:8.2f}")
 kb = f["BM_BandpassFixedBlock"]
 print(f"  ratios: block kernel / sosfilt (4096) {kb/s4:.2f}, / sosfilt (1 M) {kb/s1m:.2f}, "
+      f"1 M-sample block / sosfilt (1 M) {f['BM_BandpassFixedBlock1M']/s1m:.2f}, "
       f"/ sc_fixed {kb/sc:.0f}; per-sample kernel / sc_fixed {k/sc:.0f}")
 print()
 print("Streaming decode (ranging decode --json of a WAV train, /usr/bin/time -v; MS/s per CPU second):")

@@ -135,6 +135,34 @@ TEST(BandpassSplit, ALaneThatDoesNotReachTheTrueStateIsRecomputed) {
   }
 }
 
+TEST(BandpassSplit, AFailingSplitBacksOffThenRetries) {
+  // Ringing into digital silence with truncation, over three long blocks: every split fails
+  // (the true run keeps a limit cycle the zero-started lanes never reach). The filter runs the
+  // second block plainly, tries the third again; the outputs are the plain loop's throughout.
+  const ReceiverDesign d = default_design();
+  BandpassFixedConfig c = d.config.bandpass;
+  c.rounding = Rounding::Truncate;
+  const std::size_t block = kBandpassSplitMin + 1000, n = 3 * block;
+  const std::vector<std::int64_t> in = codes(signal(n, 0.9, 0.0, 50000, 7), c.input_bits);
+  BandpassFixed split(d.filter, c), plain(d.filter, c);
+  std::vector<std::int64_t> ys(n), yp(n);
+  for (std::size_t i = 0; i < n; i += block) {
+    split.execute_block(std::span<const std::int64_t>(in).subspan(i, block), std::span<std::int64_t>(ys).subspan(i, block));
+  }
+  for (std::size_t i = 0; i < n; i += kShort) {
+    const std::size_t m = std::min(kShort, n - i);
+    plain.execute_block(std::span<const std::int64_t>(in).subspan(i, m), std::span<std::int64_t>(yp).subspan(i, m));
+  }
+  EXPECT_EQ(ys, yp);
+  EXPECT_EQ(split.section_outputs(), plain.section_outputs());
+  if (batch::batch_kernels_available()) {
+    const BandpassSplitStats st = split.split_stats();
+    EXPECT_EQ(st.blocks, 2u);
+    EXPECT_EQ(st.skipped, 1u);
+    EXPECT_EQ(st.recomputed, 14u);
+  }
+}
+
 TEST(BandpassSplit, FloatLongBlockIsThePlainLoopBitForBit) {
   const ReceiverDesign d = default_design();
   const std::size_t n = kBandpassSplitMin + 4321;

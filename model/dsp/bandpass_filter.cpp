@@ -316,6 +316,27 @@ std::size_t time_split(const T* in, T* out, std::size_t n, std::vector<St>& stat
   return redone;
 }
 
+// Runs split() (a time_split, returning the lanes redone) unless the filter is backing off after
+// a failed split; false when it did not run (the caller runs the plain kernel).
+template <class Split>
+bool try_split(BandpassSplitBackoff& b, BandpassSplitStats& st, Split&& split) {
+  if (b.skip > 0) {
+    --b.skip;
+    ++st.skipped;
+    return false;
+  }
+  const std::size_t redone = split();
+  ++st.blocks;
+  st.recomputed += redone;
+  if (redone >= 2) {  // about what the split saves: back off, longer each time it fails again
+    b.backoff = std::min<std::size_t>(64, b.backoff ? 2 * b.backoff : 1);
+    b.skip = b.backoff;
+  } else {
+    b.backoff = 0;
+  }
+  return true;
+}
+
 // The float cascade on the lanes: batch::bandpass_batch_float (BandpassFloat's expression).
 struct FloatSplitOps {
   using St = BandpassFloat::State;
@@ -356,14 +377,14 @@ void BandpassFloat::execute_block(std::span<const double> in, std::span<double> 
     for (std::size_t i = 0; i < in.size(); ++i) out[i] = execute(in[i]);
     return;
   }
-  if (in.size() >= kSplitMin && !ranges_overlap(in.data(), out.data(), in.size() * sizeof(double)) &&
-      batch::batch_kernels_available()) {
+  const bool long_block = in.size() >= kSplitMin &&
+                          !ranges_overlap(in.data(), out.data(), in.size() * sizeof(double)) &&
+                          batch::batch_kernels_available();
+  const bool split = long_block && try_split(backoff_, split_, [&] {
     FloatSplitOps ops(sections_);
-    split_.recomputed += time_split<double, State, batch::LanesF>(in.data(), out.data(), in.size(), state_, ops);
-    ++split_.blocks;
-  } else {
-    float_dispatch(in.data(), out.data(), in.size(), sections_, state_);
-  }
+    return time_split<double, State, batch::LanesF>(in.data(), out.data(), in.size(), state_, ops);
+  });
+  if (!split) float_dispatch(in.data(), out.data(), in.size(), sections_, state_);
   for (std::size_t k = 0; k < sections_.size(); ++k) out_[k] = state_[k].y1;  // the last sample's
 }
 
@@ -581,11 +602,14 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
   check_input(in);  // once per block
   const std::int64_t in_scale = std::int64_t{1} << input_shift_;
   const int qshift = config_.coef_frac;  // acc_frac - data_frac
-  if (coef_.size() <= static_cast<std::size_t>(batch::kBatchMaxSections) && in.size() >= kSplitMin &&
-      !ranges_overlap(in.data(), out.data(), in.size() * sizeof(std::int64_t)) && batch::batch_kernels_available()) {
-    FixedSplitOps<State> ops(coef_, config_, input_shift_, data_range_, bias_ok_, sym_ok_, section_events_);
-    split_.recomputed += time_split<std::int64_t, State, batch::Lanes>(in.data(), out.data(), in.size(), state_, ops);
-    ++split_.blocks;
+  const bool long_block = coef_.size() <= static_cast<std::size_t>(batch::kBatchMaxSections) &&
+                          in.size() >= kSplitMin &&
+                          !ranges_overlap(in.data(), out.data(), in.size() * sizeof(std::int64_t)) &&
+                          batch::batch_kernels_available();
+  if (long_block && try_split(backoff_, split_, [&] {
+        FixedSplitOps<State> ops(coef_, config_, input_shift_, data_range_, bias_ok_, sym_ok_, section_events_);
+        return time_split<std::int64_t, State, batch::Lanes>(in.data(), out.data(), in.size(), state_, ops);
+      })) {
     for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
     return;
   }

@@ -72,12 +72,19 @@ BandpassHeadroom bandpass_headroom(const BandpassFixedConfig& config, const SosF
 // Long blocks (>= 540672 samples, when the CPU has AVX-512) run as 8 segments in lockstep on
 // SIMD lanes, each lane after the first starting 16384 samples early from the zero state; a
 // lane whose state at its segment's start is not bit for bit the true one is recomputed by the
-// scalar kernel (bandpass_filter.cpp, "time split"). Results never depend on it; the counts say
-// how often it ran and how often a lane had to be redone (that costs time only).
+// scalar kernel (bandpass_filter.cpp, "time split"). Noise makes the lanes meet the true state;
+// a noiseless periodic input can keep them an LSB apart for ever, so after a block with 2 or
+// more lanes redone the filter runs the next long blocks plainly (1, 2, 4 .. 64 of them, the
+// count doubling while the split keeps failing). Results never depend on any of it; the counts
+// say how often it ran, how often a lane had to be redone and how many blocks backed off.
 inline constexpr std::size_t kBandpassSplitMin = 540672;  // the shortest block split (16384 + 8 * 65536)
 struct BandpassSplitStats {
   std::size_t blocks = 0;      // blocks that ran on the lanes
   std::size_t recomputed = 0;  // lanes recomputed by the scalar kernel
+  std::size_t skipped = 0;     // long blocks run plainly, backing off after a failed split
+};
+struct BandpassSplitBackoff {  // the filter's back-off (kept by reset(): the input is alike)
+  std::size_t skip = 0, backoff = 0;
 };
 
 class BandpassFilter {  // same API for every precision
@@ -112,6 +119,7 @@ class BandpassFloat final : public BandpassFilter {
   std::vector<State> state_;
   std::vector<double> out_;
   BandpassSplitStats split_;
+  BandpassSplitBackoff backoff_;
 };
 
 class BandpassFixed final : public BandpassFilter {
@@ -166,6 +174,7 @@ class BandpassFixed final : public BandpassFilter {
   bool sym_ok_ = false;   // every numerator is b0 [1, 0, -1]: one multiply (see .cpp)  // the RoundHalfUp kernel may fold its rounding constant (see .cpp)
   OverflowCounter section_events_, input_events_;
   BandpassSplitStats split_;
+  BandpassSplitBackoff backoff_;
   [[noreturn]] void throw_input_range(std::int64_t x_in) const;
 };
 
