@@ -266,6 +266,7 @@ bool same_state(const std::vector<St>& a, const std::vector<St>& b) {
 }
 
 // Ops: set_lane(l, state), get_lane(l) -> state, interleave(src, lanes, m), run(in, out, m),
+// deinterleave(lanes, dst, m),
 // snapshot() (overflow counts at the end of the warm-up), commit(l) (lane l's counts of its
 // own outputs into the filter's counters) and scalar(in, out, m, state) (the plain kernel,
 // counting into the filter's counters). Returns how many lanes were recomputed.
@@ -280,17 +281,18 @@ std::size_t time_split(const T* in, T* out, std::size_t n, std::vector<St>& stat
   for (std::size_t l = 1; l < L; ++l) ops.set_lane(l, zero);
   std::vector<std::vector<St>> at_b(L);  // lane l's state at b_l
   std::vector<LaneT> ib(kSplitStep), ob(kSplitStep);
+  std::vector<T> discard(kSplitStep);  // where the warm-up outputs go
   for (std::size_t t0 = 0; t0 < steps;) {
     const std::size_t m = std::min(kSplitStep, (t0 < W ? W : steps) - t0);
     const T* p[L];
-    for (std::size_t l = 0; l < L; ++l) p[l] = src[l] + t0;
+    T* o[L];
+    for (std::size_t l = 0; l < L; ++l) {
+      p[l] = src[l] + t0;
+      o[l] = l > 0 && t0 < W ? discard.data() : out + l * seg + t0;
+    }
     ops.interleave(p, ib.data(), m);
     ops.run(ib.data(), ob.data(), m);
-    for (std::size_t l = 0; l < L; ++l) {
-      if (l > 0 && t0 < W) continue;  // a warm-up output
-      T* o = out + l * seg + t0;
-      for (std::size_t i = 0; i < m; ++i) o[i] = ob[i].v[l];
-    }
+    ops.deinterleave(ob.data(), o, m);
     t0 += m;
     if (t0 == W) {
       for (std::size_t l = 1; l < L; ++l) at_b[l] = ops.get_lane(l);
@@ -363,6 +365,9 @@ struct FloatSplitOps {
     batch::interleave_batch_float(src, 1.0, o, m);  // x * 1.0 == x, bit for bit
   }
   void run(const batch::LanesF* i, batch::LanesF* o, std::size_t m) { batch::bandpass_batch_float(b, i, o, m); }
+  void deinterleave(const batch::LanesF* i, double* const* dst, std::size_t m) {
+    batch::deinterleave_batch_float(i, dst, m);
+  }
   void snapshot() {}
   void commit(std::size_t) {}
   void scalar(const double* i, double* o, std::size_t m, std::vector<St>& s) { float_dispatch(i, o, m, c, s); }
@@ -579,6 +584,9 @@ struct FixedSplitOps {
     batch::interleave_batch(src, o, m, &lo, &hi);
   }
   void run(const batch::Lanes* i, batch::Lanes* o, std::size_t m) { batch::bandpass_batch(b, i, o, m); }
+  void deinterleave(const batch::Lanes* i, std::int64_t* const* dst, std::size_t m) {
+    batch::deinterleave_batch(i, dst, m);
+  }
   void snapshot() { std::copy(std::begin(ev), std::end(ev), std::begin(snap)); }
   void commit(std::size_t l) {
     target.saturations += ev[l].saturations - (l ? snap[l].saturations : 0);

@@ -127,6 +127,10 @@ void interleave_batch_float(const double* const* src, double gain, LanesF* out, 
 // out[i].v[l] = src[l][i]; *lo and *hi become min(*lo, every value) and max(*hi, every value).
 void interleave_batch(const std::int64_t* const* src, Lanes* out, std::size_t n, std::int64_t* lo, std::int64_t* hi);
 
+// The inverse: dst[l][i] = in[i].v[l] for i < n and every lane l (dst[l] has n writable values).
+void deinterleave_batch(const Lanes* in, std::int64_t* const* dst, std::size_t n);
+void deinterleave_batch_float(const LanesF* in, double* const* dst, std::size_t n);
+
 // out[i] = the cascade of in[i] (input codes, in range: the caller checks) for i < n, per lane.
 void bandpass_batch(BandpassBatch& s, const Lanes* in, Lanes* out, std::size_t n);
 

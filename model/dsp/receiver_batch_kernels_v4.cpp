@@ -338,6 +338,32 @@ void interleave_batch(const std::int64_t* const* src, Lanes* out, std::size_t n,
   *hi = b;
 }
 
+void deinterleave_batch(const Lanes* in, std::int64_t* const* dst, std::size_t n) {
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    V r[8];
+    for (int k = 0; k < 8; ++k) r[k] = load(in[i + k]);
+    transpose8(r);
+    for (int l = 0; l < 8; ++l) __builtin_memcpy(dst[l] + i, &r[l], sizeof r[l]);
+  }
+  for (; i < n; ++i) {
+    for (int l = 0; l < kBatchLanes; ++l) dst[l][i] = in[i].v[l];
+  }
+}
+
+void deinterleave_batch_float(const LanesF* in, double* const* dst, std::size_t n) {
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    D r[8];
+    for (int k = 0; k < 8; ++k) r[k] = loadf(in[i + k]);
+    transpose8(r);
+    for (int l = 0; l < 8; ++l) __builtin_memcpy(dst[l] + i, &r[l], sizeof r[l]);
+  }
+  for (; i < n; ++i) {
+    for (int l = 0; l < kBatchLanes; ++l) dst[l][i] = in[i].v[l];
+  }
+}
+
 unsigned gate_batch_float(const FloatBankBatch& s, double threshold, double min_energy) {
   D top = loadf(s.q[0]);
   for (int j = 1; j < s.codes; ++j) {
@@ -478,6 +504,8 @@ bool batch_kernels_available() { return false; }
 unsigned gate_batch_float(const FloatBankBatch&, double, double) { return ~0u; }
 void interleave_batch_float(const double* const*, double, LanesF*, std::size_t) {}
 void interleave_batch(const std::int64_t* const*, Lanes*, std::size_t, std::int64_t*, std::int64_t*) {}
+void deinterleave_batch(const Lanes*, std::int64_t* const*, std::size_t) {}
+void deinterleave_batch_float(const LanesF*, double* const*, std::size_t) {}
 void bandpass_batch(BandpassBatch&, const Lanes*, Lanes*, std::size_t) {}
 std::size_t bank_feed_batch(BankBatch&, const Lanes*, std::size_t, bool* ready) {
   *ready = false;
