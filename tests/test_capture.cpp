@@ -150,6 +150,14 @@ TEST(Capture, BadWavIsRefusedWithByteOffset) {
   c.samples[7] = std::nan("");
   EXPECT_NE(err(capture_wav(c, WavFormat::Float64)).find("cap.wav: byte 100: sample 7 is not finite"), std::string::npos)
       << err(capture_wav(c, WavFormat::Float64));
+  // and in a one-channel 32-bit float WAV (its vectorized reader): the first bad sample, NaN or Inf
+  EXPECT_NE(err(capture_wav(c, WavFormat::Float32)).find("cap.wav: byte 72: sample 7 is not finite"), std::string::npos)
+      << err(capture_wav(c, WavFormat::Float32));
+  c.samples[7] = 0.25;
+  c.samples[9] = -HUGE_VAL;
+  c.samples[11] = std::nan("");
+  EXPECT_NE(err(capture_wav(c, WavFormat::Float32)).find("cap.wav: byte 80: sample 9 is not finite"), std::string::npos)
+      << err(capture_wav(c, WavFormat::Float32));
 }
 
 // The codes of each format, as scipy.io.wavfile and other tools write them (little-endian,

@@ -1,6 +1,7 @@
 #include "model/sim/capture.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <charconv>
 #include <cerrno>
@@ -464,7 +465,21 @@ void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const st
     const std::size_t i = i0 + k;
     fail_wav(origin, w.body + i * w.frame + w.offset, "sample " + std::to_string(i) + " is not finite (NaN or Inf)");
   };
-  if (w.flt && w.bits == 32) {
+  if (w.flt && w.bits == 32 && f == 4 && std::endian::native == std::endian::little) {
+    // one channel of float32 on a little-endian host: contiguous, vectorizes
+    std::uint32_t bad = 0;
+    for (std::size_t k = 0; k < frames; ++k) {
+      std::uint32_t bits;
+      std::memcpy(&bits, u + 4 * k, sizeof bits);
+      bad |= static_cast<std::uint32_t>((bits & 0x7f800000u) == 0x7f800000u);  // exponent all ones: NaN, Inf
+      out[k] = std::bit_cast<float>(bits);
+    }
+    if (bad) {
+      for (std::size_t k = 0; k < frames; ++k) {
+        if (!std::isfinite(out[k])) not_finite(k);
+      }
+    }
+  } else if (w.flt && w.bits == 32) {
     for (std::size_t k = 0; k < frames; ++k, u += f) {
       const auto bits = static_cast<std::uint32_t>(le(u, 4));
       float x;
