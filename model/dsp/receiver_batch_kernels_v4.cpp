@@ -338,11 +338,14 @@ void interleave_batch(const std::int64_t* const* src, Lanes* out, std::size_t n,
   *hi = b;
 }
 
-void deinterleave_batch(const Lanes* in, std::int64_t* const* dst, std::size_t n) {
+namespace {
+// dst[l][i] = in[i].v[l]: 8 x 8 transposes, then the last n % 8 rows one by one.
+template <class Vec, class Row, class E>
+void deinterleave_rows(const Row* in, E* const* dst, std::size_t n) {
   std::size_t i = 0;
   for (; i + 8 <= n; i += 8) {
-    V r[8];
-    for (int k = 0; k < 8; ++k) r[k] = load(in[i + k]);
+    Vec r[8];
+    for (int k = 0; k < 8; ++k) __builtin_memcpy(&r[k], in[i + k].v, sizeof r[k]);
     transpose8(r);
     for (int l = 0; l < 8; ++l) __builtin_memcpy(dst[l] + i, &r[l], sizeof r[l]);
   }
@@ -350,18 +353,12 @@ void deinterleave_batch(const Lanes* in, std::int64_t* const* dst, std::size_t n
     for (int l = 0; l < kBatchLanes; ++l) dst[l][i] = in[i].v[l];
   }
 }
+}  // namespace
+
+void deinterleave_batch(const Lanes* in, std::int64_t* const* dst, std::size_t n) { deinterleave_rows<V>(in, dst, n); }
 
 void deinterleave_batch_float(const LanesF* in, double* const* dst, std::size_t n) {
-  std::size_t i = 0;
-  for (; i + 8 <= n; i += 8) {
-    D r[8];
-    for (int k = 0; k < 8; ++k) r[k] = loadf(in[i + k]);
-    transpose8(r);
-    for (int l = 0; l < 8; ++l) __builtin_memcpy(dst[l] + i, &r[l], sizeof r[l]);
-  }
-  for (; i < n; ++i) {
-    for (int l = 0; l < kBatchLanes; ++l) dst[l][i] = in[i].v[l];
-  }
+  deinterleave_rows<D>(in, dst, n);
 }
 
 unsigned gate_batch_float(const FloatBankBatch& s, double threshold, double min_energy) {
