@@ -344,13 +344,8 @@ struct FloatSplitOps {
   using St = BandpassFloat::State;
   const std::vector<Biquad>& c;
   batch::FloatBandpassBatch b;
-  explicit FloatSplitOps(const std::vector<Biquad>& sections) : c(sections) {
-    b.sections = static_cast<int>(c.size());
-    for (std::size_t k = 0; k < c.size(); ++k) {
-      const double v[5] = {c[k].b0, c[k].b1, c[k].b2, c[k].a1, c[k].a2};
-      for (int i = 0; i < 5; ++i) b.coef[k][i] = v[i];
-    }
-  }
+  explicit FloatSplitOps(const std::vector<Biquad>& sections)
+      : c(sections), b(bandpass_batch_constants(sections)) {}
   void set_lane(std::size_t l, const std::vector<St>& s) {
     for (std::size_t k = 0; k < s.size(); ++k) {
       b.x1[k].v[l] = s[k].x1, b.x2[k].v[l] = s[k].x2, b.y1[k].v[l] = s[k].y1, b.y2[k].v[l] = s[k].y2;
@@ -550,22 +545,10 @@ struct FixedSplitOps {
   OverflowCounter& target;  // the filter's section counters
   batch::BandpassBatch b;
   OverflowCounter ev[batch::kBatchLanes] = {}, snap[batch::kBatchLanes] = {};
-  FixedSplitOps(const std::vector<std::vector<std::int64_t>>& c, const BandpassFixedConfig& config, int input_shift,
-                const FxRange& r, bool bias_ok, bool sym_ok, OverflowCounter& counter)
-      : coef(c), cfg(config), in_scale(std::int64_t{1} << input_shift), range(r), bias(bias_ok), sym(sym_ok),
-        target(counter) {
-    b.sections = static_cast<int>(c.size());
-    for (std::size_t k = 0; k < c.size(); ++k) {
-      for (int i = 0; i < 5; ++i) b.coef[k][i] = c[k][static_cast<std::size_t>(i)];
-    }
-    b.input_shift = input_shift;
-    b.qshift = cfg.coef_frac;
-    b.rounding = cfg.rounding;
-    b.overflow = cfg.overflow;
-    b.range = r;
-    // 32 x 32 -> 64 multiplies when every factor fits int32 (as ReceiverFixedBatch decides)
-    b.narrow = cfg.coef_bits <= 32 && cfg.data_bits <= 31 && cfg.data_frac <= 29;
-    b.sym = sym_ok;
+  FixedSplitOps(const BandpassFixed& f, int input_shift, bool bias_ok, OverflowCounter& counter)
+      : coef(f.coefficients()), cfg(f.config()), in_scale(std::int64_t{1} << input_shift),
+        range(fx_range(f.data_format())), bias(bias_ok), sym(f.sym()), target(counter),
+        b(bandpass_batch_constants(f)) {
     b.events = ev;
   }
   void set_lane(std::size_t l, const std::vector<St>& s) {
@@ -615,7 +598,7 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
                           !ranges_overlap(in.data(), out.data(), in.size() * sizeof(std::int64_t)) &&
                           batch::batch_kernels_available();
   if (long_block && try_split(backoff_, split_, [&] {
-        FixedSplitOps<State> ops(coef_, config_, input_shift_, data_range_, bias_ok_, sym_ok_, section_events_);
+        FixedSplitOps<State> ops(*this, input_shift_, bias_ok_, section_events_);
         return time_split<std::int64_t, State, batch::Lanes>(in.data(), out.data(), in.size(), state_, ops);
       })) {
     for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
@@ -664,6 +647,38 @@ SosFilter BandpassFixed::quantized_filter() const {
     q.sections[k] = Biquad{c[0] * s, c[1] * s, c[2] * s, c[3] * s, c[4] * s};
   }
   return q;
+}
+
+batch::BandpassBatch bandpass_batch_constants(const BandpassFixed& filter) {
+  const auto& cfg = filter.config();
+  const auto& coef = filter.coefficients();
+  batch::BandpassBatch b;
+  b.sections = static_cast<int>(coef.size());
+  for (std::size_t k = 0; k < coef.size(); ++k) {
+    for (int i = 0; i < 5; ++i) b.coef[k][i] = coef[k][static_cast<std::size_t>(i)];
+  }
+  b.input_shift = cfg.data_frac - (cfg.input_bits - 1);
+  b.qshift = cfg.coef_frac;
+  b.rounding = cfg.rounding;
+  b.overflow = cfg.overflow;
+  b.range = fx_range(filter.data_format());
+  // 32 x 32 -> 64 multiplies when every factor fits int32: |coef| < 2^31, the section outputs
+  // |y| <= 2^30 (data_bits <= 31), the aligned input |x| <= 2^data_frac <= 2^29, so also
+  // |x - x2| < 2^31 (the one-multiply numerator).
+  b.narrow = cfg.coef_bits <= 32 && cfg.data_bits <= 31 && cfg.data_frac <= 29;
+  b.sym = filter.sym();
+  return b;
+}
+
+batch::FloatBandpassBatch bandpass_batch_constants(const std::vector<Biquad>& sections) {
+  batch::FloatBandpassBatch b;
+  b.sections = static_cast<int>(sections.size());
+  for (std::size_t k = 0; k < sections.size(); ++k) {
+    const Biquad& c = sections[k];
+    const double v[5] = {c.b0, c.b1, c.b2, c.a1, c.a2};
+    for (int i = 0; i < 5; ++i) b.coef[k][i] = v[i];
+  }
+  return b;
 }
 
 }  // namespace ranging

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "model/dsp/fixed_point.hpp"
+#include "model/dsp/receiver_batch_kernels.hpp"
 #include "model/dsp/sos.hpp"
 
 namespace ranging {
@@ -86,6 +87,14 @@ struct BandpassSplitStats {
 struct BandpassSplitBackoff {  // the filter's back-off (kept by reset(): the input is alike)
   std::size_t skip = 0, backoff = 0;
 };
+
+// The SIMD kernels' constants of a cascade (receiver_batch_kernels.hpp), zero state, no event
+// counters: the float coefficients; for the fixed filter also its shifts, rounding, overflow,
+// data range, one-multiply form and whether every factor fits a 32 x 32 multiply. What
+// ReceiverFixedBatch / ReceiverFloatBatch and the time split run. Defined after the classes.
+class BandpassFixed;
+batch::BandpassBatch bandpass_batch_constants(const BandpassFixed& filter);
+batch::FloatBandpassBatch bandpass_batch_constants(const std::vector<Biquad>& sections);
 
 class BandpassFilter {  // same API for every precision
  public:

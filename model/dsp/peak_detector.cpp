@@ -18,12 +18,12 @@ int argmax(std::span<const T> q) {  // the first of the largest
 }
 
 template <class T>
-void best_two(std::span<const T> q, int& best, T& second) {
-  best = argmax(q);
-  second = T{};
+T second_best(std::span<const T> q, int best) {  // the largest of the others (0 if none)
+  T second{};
   for (int j = 0; j < static_cast<int>(q.size()); ++j) {
     if (j != best && q[j] > second) second = q[j];
   }
+  return second;
 }
 
 // The candidate's life cycle, the same in both precisions. The output after the candidate's
@@ -120,15 +120,14 @@ std::optional<Event> PeakDetectorFloat::execute(std::span<const double> q, std::
 
 std::optional<Event> PeakDetectorFloat::execute(std::span<const double> q, std::span<const double> prev,
                                                 std::int64_t n, double energy) {
-  // no candidate (most outputs): a closed gate changes nothing
-  if (!cand_ && !gate(q[static_cast<std::size_t>(argmax(q))], energy)) return std::nullopt;
-  int best;
-  double second;
-  best_two(q, best, second);
+  const int best = argmax(q);
+  const bool open = gate(q[static_cast<std::size_t>(best)], energy);
+  if (!cand_ && !open) return std::nullopt;  // no candidate (most outputs): nothing changes
+  const double second = second_best(q, best);
   take_right_neighbour(cand_, q);
   const double rho2 = energy > 0 ? q[static_cast<std::size_t>(best)] / energy : 0.0;  // CorrelatorBankFloat::rho2
   const double margin = rho2 - (energy > 0 ? second / energy : 0.0);
-  return next_candidate(cand_, gate(q[static_cast<std::size_t>(best)], energy) && (!cand_ || rho2 > cand_->score),
+  return next_candidate(cand_, open && (!cand_ || rho2 > cand_->score),
                         Candidate{n, best, prev[static_cast<std::size_t>(best)], q[static_cast<std::size_t>(best)],
                                   0.0, rho2, margin, false},
                         n, holdoff_, [this](const Candidate& c) { return make_event(c); });
@@ -181,20 +180,18 @@ std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& 
 std::optional<EventFixed> PeakDetectorFixed::execute(std::span<const std::uint64_t> q, std::int64_t n,
                                                      std::uint64_t norm) {
   if (prev_.empty()) prev_.assign(q.size(), 0);
-  if (!cand_) {  // no candidate (most outputs): a closed gate changes nothing but prev_
-    if (!gate(q[static_cast<std::size_t>(argmax(q))], norm)) {
-      prev_.assign(q.begin(), q.end());
-      return std::nullopt;
-    }
+  const int best = argmax(q);
+  const bool open = gate(q[static_cast<std::size_t>(best)], norm);
+  if (!cand_ && !open) {  // no candidate (most outputs): nothing changes but prev_
+    prev_.assign(q.begin(), q.end());
+    return std::nullopt;
   }
-  int best;
-  std::uint64_t second;
-  best_two(q, best, second);
+  const std::uint64_t second = second_best(q, best);
   take_right_neighbour(cand_, q);
   // rho^2 of the best code beats the candidate's: Q / norm > Q_c / norm_c, cross-multiplied.
   const bool better = !cand_ || static_cast<uint128_t>(q[best]) * std::max<std::uint64_t>(cand_->norm, 1) >
                                     static_cast<uint128_t>(cand_->q) * std::max<std::uint64_t>(norm, 1);
-  auto out = next_candidate(cand_, gate(q[best], norm) && better,
+  auto out = next_candidate(cand_, open && better,
                             Candidate{n, best, prev_[best], q[best], 0, second, norm, false}, n,
                             holdoff_, [this](const Candidate& c) { return make_event(c); });
   prev_.assign(q.begin(), q.end());

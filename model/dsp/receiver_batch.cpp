@@ -99,22 +99,7 @@ struct ReceiverFixedBatch::Kernels {
 
   explicit Kernels(const ReceiverDesign& d)
       : filter(d.filter, d.config.bandpass) {
-    const auto& cfg = filter.config();
-    const auto& coef = filter.coefficients();
-    bp.sections = static_cast<int>(coef.size());
-    for (std::size_t k = 0; k < coef.size(); ++k) {
-      for (int i = 0; i < 5; ++i) bp.coef[k][i] = coef[k][static_cast<std::size_t>(i)];
-    }
-    bp.input_shift = cfg.data_frac - (cfg.input_bits - 1);
-    bp.qshift = cfg.coef_frac;
-    bp.rounding = cfg.rounding;
-    bp.overflow = cfg.overflow;
-    bp.range = fx_range(filter.data_format());
-    // 32 x 32 -> 64 multiplies when every factor fits int32: |coef| < 2^31, the section
-    // outputs |y| <= 2^30 (data_bits <= 31), the aligned input |x| <= 2^data_frac <= 2^29, so
-    // also |x - x2| < 2^31 (the one-multiply numerator).
-    bp.narrow = cfg.coef_bits <= 32 && cfg.data_bits <= 31 && cfg.data_frac <= 29;
-    bp.sym = filter.sym();
+    bp = bandpass_batch_constants(filter);
     bp.events = bp_events;
 
     const auto& l = d.layout;
@@ -250,14 +235,7 @@ struct ReceiverFloatBatch::Kernels {
   std::vector<LanesF> in, out;
   std::vector<double> zeros = std::vector<double>(kChunk);  // an ended lane's input
 
-  explicit Kernels(const ReceiverDesign& d) : scalar(d.reference) {
-    const auto& sec = d.filter.sections;
-    bp.sections = static_cast<int>(sec.size());
-    for (std::size_t k = 0; k < sec.size(); ++k) {
-      const Biquad& c = sec[k];
-      const double v[5] = {c.b0, c.b1, c.b2, c.a1, c.a2};
-      for (int i = 0; i < 5; ++i) bp.coef[k][i] = v[i];
-    }
+  explicit Kernels(const ReceiverDesign& d) : bp(bandpass_batch_constants(d.filter.sections)), scalar(d.reference) {
     const CorrelatorReference& r = d.reference;
     auto& b = bank;
     b.period = r.period;

@@ -117,17 +117,19 @@ PearsonBank::Plan& PearsonBank::plan(std::size_t nfft) {
 }
 
 namespace {
+// A function with an AVX-512 clone beside the baseline one, picked at load time by the CPU.
+#if defined(__x86_64__)
+#define RANGING_CLONE_V4 [[gnu::target_clones("default", "arch=x86-64-v4")]]
+#else
+#define RANGING_CLONE_V4
+#endif
+
 // Per lag k < lags of the window (prefix sums s1, s2 of x - mean): var_k = max(0, S2 - S1^2 / N)
 // over x[k, k + N); then den_k = sqrt(var_k), 0 where the window is flat (var_k <= 1e-24 of the
 // largest, or 0: rho = 0 there), inv_den_k = 1 / den_k (0 there). Every lag on its own, IEEE
 // operations only (divide, sqrt, max), so the AVX-512 clone (picked at load time on a CPU that
 // has it) gives the baseline's bits. metrics.cpp is built with -fno-math-errno, so sqrt is the
 // instruction (and vectorizes); the argument is never negative, errno was never set.
-#if defined(__x86_64__)
-#define RANGING_CLONE_V4 [[gnu::target_clones("default", "arch=x86-64-v4")]]
-#else
-#define RANGING_CLONE_V4
-#endif
 RANGING_CLONE_V4 void lag_norms(const double* s1, const double* s2, std::size_t n, std::size_t lags, double* den,
                                 double* inv_den) {
   const auto nd = static_cast<double>(n);
