@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <string>
 
 #include "model/base/error.hpp"
+#include "model/dsp/bank_lanes.hpp"
 
 namespace ranging {
 namespace {
@@ -344,8 +346,13 @@ CorrelatorBankFixed::CorrelatorBankFixed(const CorrelatorReference& ref,
 }
 
 void CorrelatorBankFixed::reset() {
-  const auto& l = layout_;
   n_ = 0;
+  clear_state();
+  mix_events_ = chip_events_ = corr_events_ = {};
+}
+
+void CorrelatorBankFixed::clear_state() {
+  const auto& l = layout_;
   phase_ = 0;
   dec_phase_ = 0;
   ready_ = false;
@@ -366,7 +373,6 @@ void CorrelatorBankFixed::reset() {
   comb_re_.assign(l.codes, 0);
   comb_im_.assign(l.codes, 0);
   chip_acc_re_ = chip_acc_im_ = 0;
-  mix_events_ = chip_events_ = corr_events_ = {};
 }
 
 bool CorrelatorBankFixed::execute(std::int64_t y) {
@@ -488,6 +494,161 @@ void CorrelatorBankFixed::decimated_output() {
     p_[j] = static_cast<std::uint64_t>(corr_re_[j] * corr_re_[j] + corr_im_[j] * corr_im_[j]);
     q_[j] = p_[j] * static_cast<std::uint64_t>(l.weights[j]);
   }
+}
+
+// ---- the bank on the SIMD lanes ---------------------------------------------------------
+
+FixedBankLanes::FixedBankLanes(const CorrelatorBankFixed& bank) {
+  const CorrelatorFixedLayout& l = bank.layout_;
+  b.period = l.period;
+  b.decimation = l.decimation;
+  b.taps = l.taps;
+  b.chips = l.chips;
+  b.codes = l.codes;
+  b.step = l.chip_samples / l.decimation;
+  b.mix_shift = l.mix_shift;
+  b.chip_shift = l.chip_shift;
+  b.corr_shift = l.corr_shift;
+  b.mix_range = bank.mix_range_;
+  b.chip_range = bank.chip_range_;
+  b.corr_range = bank.corr_range_;
+  // taps < 2^(tap_bits-1) <= 2^23; Bd < 2^(dec_bits-1); C_q < 2^(corr_bits-1)
+  b.fir_narrow = bank.cfg_.tap_bits <= 32 && l.dec_bits <= 32;
+  b.power_narrow = bank.cfg_.corr_bits <= 32;
+  lo_cos = l.lo_cos;
+  for (std::int64_t v : l.lo_sin) lo_nsin.push_back(-v);
+  taps_rev = bank.taps_rev_;
+  sign_mask = bank.sign_mask_;
+  weights = l.weights;
+  b.lo_cos = lo_cos.data();
+  b.lo_nsin = lo_nsin.data();
+  b.taps_rev = taps_rev.data();
+  b.sign_mask = sign_mask.data();
+  b.weights = weights.data();
+  b.window = static_cast<std::size_t>(l.window);
+  b.bd_n = bank.bd_n_;
+  b.f_n = bank.f_n_;
+  b.mix_events = mix_events;
+  b.chip_events = chip_events;
+  b.corr_events = corr_events;
+  reset();
+}
+
+void FixedBankLanes::reset() {
+  arrays.reset(b);  // CorrelatorBankFixed::reset's positions
+  b.phase = 0;
+  for (int l = 0; l < batch::kBatchLanes; ++l) mix_events[l] = chip_events[l] = corr_events[l] = {};
+}
+
+std::size_t CorrelatorBankFixed::split_memory() const {
+  const auto& l = layout_;
+  const std::size_t P = static_cast<std::size_t>(l.period), D = static_cast<std::size_t>(l.decimation);
+  // The oldest sample the state reads: the energy window, or the oldest F's oldest Bd's moving
+  // sum (D - 1 samples since the last output, f_n - 1 outputs, bd_n - 1 outputs, P samples).
+  const std::size_t h = std::max(y2_.size(), D * (f_n_ + bd_n_ - 1) + P);
+  const std::size_t a = std::lcm(P, D);
+  return (h + a - 1) / a * a;
+}
+
+std::size_t CorrelatorBankFixed::split_min_samples() const {
+  // Segments of at least 4 H (the warm-up at most a fifth of the work), and not under 64 Ki.
+  const std::size_t h = split_memory(), a = std::lcm<std::size_t>(layout_.period, layout_.decimation);
+  return std::max<std::size_t>(std::size_t{1} << 16, h + batch::kBatchLanes * (4 * h + a));
+}
+
+bool CorrelatorBankFixed::feed_split(std::span<const std::int64_t> y, const OutputSink& out) {
+  constexpr std::size_t L = batch::kBatchLanes, kStep = 2048;  // lockstep samples at a time
+  if (y.size() < split_min_samples() || !batch::batch_kernels_available()) return false;
+  const std::size_t H = split_memory(), a = std::lcm<std::size_t>(layout_.period, layout_.decimation);
+  const std::size_t S = (y.size() - H) / (L * a) * a;  // segment: a whole number of lcm(P, D)
+  const std::size_t T = H + S;                          // lockstep steps
+  const std::size_t codes = q_.size();
+  const std::int64_t n0 = n_;
+
+  FixedBankLanes k(*this);
+  // Lane 0: this bank's state (the lanes share the positions and the phases).
+  batch::BankBatch& b = k.b;
+  b.phase = phase_;
+  b.dec_phase = dec_phase_;
+  b.y_idx = y_idx_;
+  b.bd_idx = bd_idx_;
+  b.f_idx = f_idx_;
+  b.acc_re.v[0] = acc_re_;
+  b.acc_im.v[0] = acc_im_;
+  b.energy.v[0] = static_cast<std::int64_t>(energy_);
+  const auto lane0 = [](std::vector<batch::Lanes>& dst, const auto& src) {
+    for (std::size_t i = 0; i < src.size(); ++i) dst[i].v[0] = static_cast<std::int64_t>(src[i]);
+  };
+  lane0(k.arrays.b_re, b_re_);
+  lane0(k.arrays.b_im, b_im_);
+  lane0(k.arrays.y2h, y2_);
+  lane0(k.arrays.bd_re, bd_re_);
+  lane0(k.arrays.bd_im, bd_im_);
+  lane0(k.arrays.f_re, f_re_);
+  lane0(k.arrays.f_im, f_im_);
+
+  // Every lane's outputs: at most T / D + 1 each.
+  const std::size_t cap = T / static_cast<std::size_t>(layout_.decimation) + 1;
+  split_q_.resize(L * cap * codes);
+  split_norm_.resize(L * cap);
+  split_n_.resize(L * cap);
+  std::size_t count[L] = {};
+  std::vector<batch::Lanes> in(kStep);
+  for (std::size_t t0 = 0; t0 < T;) {
+    const std::size_t m = std::min(kStep, (t0 < H ? H : T) - t0);
+    const std::int64_t* src[L];
+    for (std::size_t l = 0; l < L; ++l) src[l] = y.data() + l * S + t0;
+    std::int64_t lo = 0, hi = 0;
+    batch::interleave_batch(src, in.data(), m, &lo, &hi);
+    const std::size_t first = t0 < H ? 1 : L;  // lanes >= 1 keep no output of their warm-up
+    for (std::size_t i = 0; i < m;) {
+      bool ready = false;
+      i += batch::bank_feed_batch(b, in.data() + i, m - i, &ready);
+      if (!ready) continue;
+      const std::size_t t = t0 + i - 1;  // the step of the last sample fed
+      for (std::size_t l = 0; l < (t0 < H ? first : L); ++l) {
+        const std::size_t o = l * cap + count[l]++;
+        std::uint64_t* q = split_q_.data() + o * codes;
+        for (std::size_t j = 0; j < codes; ++j) q[j] = static_cast<std::uint64_t>(b.q[j].v[l]);
+        split_norm_[o] = static_cast<std::uint64_t>(b.energy.v[l]) >> layout_.energy_shift;
+        split_n_[o] = n0 + static_cast<std::int64_t>(l * S + t);
+      }
+    }
+    t0 += m;
+    if (t0 == H) {  // the warm-up is over: lanes >= 1 count from here
+      for (std::size_t l = 1; l < L; ++l) k.mix_events[l] = k.chip_events[l] = k.corr_events[l] = {};
+    }
+  }
+  for (std::size_t l = 0; l < L; ++l) {
+    mix_events_ += k.mix_events[l];
+    chip_events_ += k.chip_events[l];
+    corr_events_ += k.corr_events[l];
+    for (std::size_t i = 0; i < count[l]; ++i) {
+      const std::size_t o = l * cap + i;
+      out(std::span<const std::uint64_t>(split_q_.data() + o * codes, codes), split_n_[o], split_norm_[o]);
+    }
+  }
+
+  // The state after the last segment (sample L S + H - 1): re-run its H samples from reset,
+  // in phase (L S is a whole number of lcm(P, D)), their overflows not counted again.
+  const std::size_t done = L * S + H;
+  const OverflowCounter mix = mix_events_, chip = chip_events_, corr = corr_events_;
+  const int phase = phase_, dec_phase = dec_phase_;
+  clear_state();
+  phase_ = phase;
+  dec_phase_ = dec_phase;
+  n_ = n0 + static_cast<std::int64_t>(done - H);
+  for (std::span<const std::int64_t> rest = y.subspan(done - H, H); !rest.empty();) rest = rest.subspan(feed(rest));
+  mix_events_ = mix;
+  chip_events_ = chip;
+  corr_events_ = corr;
+  // The rest of the block, plainly.
+  for (std::span<const std::int64_t> rest = y.subspan(done); !rest.empty();) {
+    rest = rest.subspan(feed(rest));
+    if (ready_) out(q_, sample_index(), norm());
+  }
+  ++split_blocks_;
+  return true;
 }
 
 }  // namespace ranging

@@ -22,12 +22,15 @@
 // of the hardware: every node's width, rounding and overflow is in CorrelatorFixedLayout.
 #include <complex>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
 #include "model/dsp/fixed_point.hpp"
 
 namespace ranging {
+
+struct FixedBankLanes;  // bank_lanes.hpp: the bank on the SIMD lanes
 
 // What the bank correlates against, derived by the receiver design (receiver.hpp) from the
 // configuration: the chip template and every code's normalization.
@@ -151,6 +154,29 @@ class CorrelatorBankFixed {
   std::size_t feed(std::span<const std::int64_t> y);
   bool output_ready() const { return ready_; }
 
+  // Long-block form (the time split): feeds all of y, as feed() over it would, and calls
+  // out(Q_j, n, norm) for every decimated output in order (n the full-rate index of its last
+  // input, norm = E >> energy_shift: what PeakDetectorFixed::execute reads). The state, the
+  // accessors and the overflow counts afterwards are feed()'s, bit for bit. Runs only when the
+  // block is long enough for it (split_min_samples()) and the CPU has the SIMD kernels
+  // (receiver_batch_kernels.hpp); returns false, having done nothing, otherwise.
+  //   The bank has finite memory: its state after sample t is a function of the last
+  // split_memory() samples and of t mod lcm(P, D) alone (exact integers: the moving sums and
+  // the energy add and subtract exactly; every ring is overwritten within that span), and the
+  // reset state is the state after that many zeros. So the block runs as kBatchLanes segments
+  // in lockstep, one per SIMD lane: lane 0 from the bank's state, lane l >= 1 from reset,
+  // split_memory() samples before its segment (a whole number of lcm(P, D) after lane 0, so
+  // all lanes share the LO and decimation phases), its outputs and overflow counts taken from
+  // its segment's first sample on. No check is needed (the bandpass's IIR split must check):
+  // the warm-up lane is in the true state by construction. The outputs wait per lane and go
+  // to `out` in sample order; then the bank re-runs the split_memory() samples before the end
+  // of the last segment from reset (the same argument) and feeds the rest of the block.
+  using OutputSink = std::function<void(std::span<const std::uint64_t> q, std::int64_t n, std::uint64_t norm)>;
+  bool feed_split(std::span<const std::int64_t> y, const OutputSink& out);
+  std::size_t split_memory() const;      // H = max(W, D (f_n + M - 1) + P), rounded up to lcm(P, D)
+  std::size_t split_min_samples() const; // the shortest block feed_split takes
+  std::size_t split_blocks() const { return split_blocks_; }  // blocks split since construction
+
   // Stage taps of the last decimated output, for stage-by-stage comparison with the hardware.
   std::int64_t mix_re() const { return mix_re_; }  // last full-rate mixer output
   std::int64_t mix_im() const { return mix_im_; }
@@ -211,6 +237,12 @@ class CorrelatorBankFixed {
   std::int64_t chip_acc_re_ = 0, chip_acc_im_ = 0;
   std::vector<std::int64_t> comb_re_, comb_im_;
   OverflowCounter mix_events_, chip_events_, corr_events_;
+  // feed_split's scratch: every lane's outputs (Q_j, n, norm), kept for the next block.
+  std::vector<std::uint64_t> split_q_, split_norm_;
+  std::vector<std::int64_t> split_n_;
+  std::size_t split_blocks_ = 0;
+  friend struct FixedBankLanes;
+  void clear_state();  // reset() but the overflow counters and the sample index
 };
 
 // The float front end (mixer + one-cycle moving sum + decimation by D) applied to a whole

@@ -298,7 +298,8 @@ std::optional<EventFixed> ReceiverFixed::execute_raw(std::int64_t x) {
 
 std::size_t ReceiverFixed::execute_block(std::span<const std::int64_t> x, std::vector<EventFixed>& events) {
   // Short chunks stay in the cache; a long block is filtered in long chunks, which the
-  // bandpass runs on its SIMD lanes (BandpassSplitStats).
+  // bandpass and the bank run on their SIMD lanes (BandpassSplitStats,
+  // CorrelatorBankFixed::feed_split).
   const std::size_t chunk = x.size() >= kBandpassSplitMin ? std::min(x.size(), 2 * kBandpassSplitMin) : 1024;
   const std::size_t before = events.size();
   if (chunk_.size() < chunk) chunk_.resize(chunk);
@@ -307,6 +308,10 @@ std::size_t ReceiverFixed::execute_block(std::span<const std::int64_t> x, std::v
     const std::span<std::int64_t> y(chunk_.data(), n);
     filter_.execute_block(x.first(n), y);
     std::span<const std::int64_t> rest(y);
+    const auto detect = [&](std::span<const std::uint64_t> q, std::int64_t i, std::uint64_t norm) {
+      if (auto e = detector_.execute(q, i, norm)) events.push_back(*e);
+    };
+    if (n >= bank_.split_min_samples() && bank_.feed_split(y, detect)) rest = {};  // the bank's time split
     while (!rest.empty()) {
       rest = rest.subspan(bank_.feed(rest));
       if (bank_.output_ready()) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "model/base/error.hpp"
+#include "model/dsp/bank_lanes.hpp"
 #include "model/dsp/receiver_batch_kernels.hpp"
 
 namespace ranging {
@@ -15,36 +16,6 @@ static_assert(ReceiverFixedBatch::kLanes == static_cast<std::size_t>(kBatchLanes
 
 namespace {
 constexpr std::size_t kChunk = 1024;  // samples per lane per pass of the kernels
-
-// The bank's arrays of a batch (Lanes or LanesF), zeroed, and the kernel state pointed at them
-// in the scalar bank's reset positions (the rings' newest slot is the last one).
-template <class L, class Bank>
-struct BankArrays {
-  std::vector<L> b_re, b_im, y2h, bd_re, bd_im, f_re, f_im, q;
-  void reset(Bank& b) {
-    b_re.assign(static_cast<std::size_t>(b.period), L{});
-    b_im.assign(b_re.size(), L{});
-    y2h.assign(b.window, L{});
-    bd_re.assign(2 * b.bd_n, L{});
-    bd_im.assign(2 * b.bd_n, L{});
-    f_re.assign(2 * b.f_n, L{});
-    f_im.assign(2 * b.f_n, L{});
-    q.assign(static_cast<std::size_t>(b.codes), L{});
-    b.b_re = b_re.data();
-    b.b_im = b_im.data();
-    b.y2h = y2h.data();
-    b.bd_re = bd_re.data();
-    b.bd_im = bd_im.data();
-    b.f_re = f_re.data();
-    b.f_im = f_im.data();
-    b.q = q.data();
-    b.dec_phase = 0;
-    b.y_idx = b.window - 1;
-    b.bd_idx = b.bd_n - 1;
-    b.f_idx = b.f_n - 1;
-    b.acc_re = b.acc_im = b.energy = L{};
-  }
-};
 
 // The chunk loop of both batch receivers. The lanes run to the longest stream in chunks of at
 // most kChunk samples, and a chunk ends at every lane's end: a lane has all n samples of a
@@ -86,69 +57,29 @@ void run_chunks(std::span<const std::span<const T>> streams, const T* zeros, Chu
 }
 }  // namespace
 
-// The kernels' state, with the arrays BankBatch points into.
+// The kernels' state: the bandpass lanes and the bank's (bank_lanes.hpp).
 struct ReceiverFixedBatch::Kernels {
   batch::BandpassBatch bp;
-  batch::BankBatch bank;
   BandpassFixed filter;  // the scalar filter the constants come from (and the input range check)
-  std::vector<std::int64_t> lo_cos, lo_nsin, taps_rev, sign_mask, weights;
-  BankArrays<Lanes, batch::BankBatch> arrays;
-  OverflowCounter bp_events[kBatchLanes], mix_events[kBatchLanes], chip_events[kBatchLanes], corr_events[kBatchLanes];
+  FixedBankLanes lanes;  // the bank's constants and arrays; lanes.b is the kernel's state
+  batch::BankBatch& bank = lanes.b;
+  OverflowCounter bp_events[kBatchLanes];
   std::vector<Lanes> in, out;  // a chunk, lane-interleaved
   std::vector<std::int64_t> zeros = std::vector<std::int64_t>(kChunk);  // an ended lane's input
 
   explicit Kernels(const ReceiverDesign& d)
-      : filter(d.filter, d.config.bandpass) {
+      : filter(d.filter, d.config.bandpass), lanes(CorrelatorBankFixed(d.reference, d.config.correlator)) {
     bp = bandpass_batch_constants(filter);
     bp.events = bp_events;
-
-    const auto& l = d.layout;
-    const auto& cc = d.config.correlator;
-    auto& b = bank;
-    b.period = l.period;
-    b.decimation = l.decimation;
-    b.taps = l.taps;
-    b.chips = l.chips;
-    b.codes = l.codes;
-    b.step = l.chip_samples / l.decimation;
-    b.mix_shift = l.mix_shift;
-    b.chip_shift = l.chip_shift;
-    b.corr_shift = l.corr_shift;
-    b.mix_range = fx_range(FixedFormat{cc.mix_bits, l.mix_frac, true, Rounding::RoundHalfUp, Overflow::Saturate});
-    b.chip_range = fx_range(FixedFormat{cc.chip_bits, 0, true, Rounding::RoundHalfUp, Overflow::Saturate});
-    b.corr_range = fx_range(FixedFormat{cc.corr_bits, 0, true, Rounding::RoundHalfUp, Overflow::Saturate});
-    // taps < 2^(tap_bits-1) <= 2^23; Bd < 2^(dec_bits-1); C_q < 2^(corr_bits-1)
-    b.fir_narrow = cc.tap_bits <= 32 && l.dec_bits <= 32;
-    b.power_narrow = cc.corr_bits <= 32;
-    lo_cos = l.lo_cos;
-    for (std::int64_t v : l.lo_sin) lo_nsin.push_back(-v);
-    taps_rev.assign(l.taps_q.rbegin(), l.taps_q.rend());
-    for (const auto& code : d.reference.codes) {
-      for (std::uint8_t chip : code) sign_mask.push_back(chip ? 0 : -1);
-    }
-    weights = l.weights;
-    b.lo_cos = lo_cos.data();
-    b.lo_nsin = lo_nsin.data();
-    b.taps_rev = taps_rev.data();
-    b.sign_mask = sign_mask.data();
-    b.weights = weights.data();
-    b.window = static_cast<std::size_t>(l.window);
-    b.bd_n = static_cast<std::size_t>(l.taps);
-    b.f_n = static_cast<std::size_t>(l.chips - 1) * static_cast<std::size_t>(b.step) + 1;
-    b.mix_events = mix_events;
-    b.chip_events = chip_events;
-    b.corr_events = corr_events;
     reset();
   }
 
   void reset() {
-    auto& b = bank;
     std::fill(std::begin(bp.y1), std::end(bp.y1), Lanes{});
     std::fill(std::begin(bp.y2), std::end(bp.y2), Lanes{});
     bp.x1 = bp.x2 = Lanes{};
-    arrays.reset(b);  // CorrelatorBankFixed::reset's positions
-    b.phase = 0;
-    for (int l = 0; l < kBatchLanes; ++l) bp_events[l] = mix_events[l] = chip_events[l] = corr_events[l] = {};
+    lanes.reset();
+    for (int l = 0; l < kBatchLanes; ++l) bp_events[l] = {};
   }
 };
 
@@ -218,7 +149,7 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
   };
   const auto finish = [&](std::size_t l) {  // lane l's last sample is in: flush, read its counters
     if (auto e = det[l].flush()) events[l].push_back(*e);
-    overflows[l] = k.bp_events[l] + k.mix_events[l] + k.chip_events[l] + k.corr_events[l];
+    overflows[l] = k.bp_events[l] + k.lanes.mix_events[l] + k.lanes.chip_events[l] + k.lanes.corr_events[l];
   };
   run_chunks(streams, k.zeros.data(), chunk, finish);
 }
