@@ -11,8 +11,10 @@
 #include <cstring>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
 
+#include "model/base/error.hpp"
 #include "model/dsp/bandpass_filter.hpp"
 #include "model/dsp/quantize.hpp"
 #include "model/dsp/receiver.hpp"
@@ -234,5 +236,38 @@ TEST(BandpassSplit, ReceiversOnLongBlocksGiveTheShortBlocksEvents) {
   if (batch::batch_kernels_available()) {
     EXPECT_EQ(e.filter().split_stats().blocks, 1u);
     EXPECT_EQ(c.filter().split_stats().blocks, 0u);
+  }
+}
+
+TEST(BandpassSplit, AnOutOfRangeSampleInALongBlockThrowsAndChangesNoState) {
+  // The split checks the input on its lanes' reads and the tail after them; whichever lane or
+  // the tail holds the bad code, the block throws InputError naming it, before any state or
+  // counter changes: the filter then runs on as if the block had never come.
+  const ReceiverDesign d = default_design();
+  const BandpassFixedConfig c = d.config.bandpass;
+  const std::size_t n = kBandpassSplitMin + 3333;
+  const std::vector<std::int64_t> good = codes(signal(n, 0.5, 0.01, n, 9), c.input_bits);
+  const std::int64_t top = (std::int64_t{1} << (c.input_bits - 1)) - 1;
+  for (std::size_t at : {std::size_t{5}, n / 2, n - 2}) {  // lane 0, a middle lane, the tail (the last 5)
+    for (std::int64_t bad : {top + 1, -top - 2, std::int64_t{1} << 40}) {
+      BandpassFixed f(d.filter, c), ref(d.filter, c);
+      std::vector<std::int64_t> warm(5000, 0), y(n), yr(n), w(5000);
+      for (std::size_t i = 0; i < warm.size(); ++i) warm[i] = good[i] / 3;
+      f.execute_block(warm, w);
+      ref.execute_block(warm, w);
+      std::vector<std::int64_t> x = good;
+      x[at] = bad;
+      try {
+        f.execute_block(x, y);
+        ADD_FAILURE() << "no error for " << bad << " at " << at;
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(std::to_string(bad)), std::string::npos) << e.what();
+      }
+      EXPECT_EQ(f.section_outputs(), ref.section_outputs());
+      EXPECT_EQ(f.overflow_events().total(), ref.overflow_events().total());
+      f.execute_block(good, y);
+      ref.execute_block(good, yr);
+      EXPECT_EQ(y, yr) << "after the error at " << at;
+    }
   }
 }

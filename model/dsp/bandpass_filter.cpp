@@ -266,7 +266,8 @@ bool same_state(const std::vector<St>& a, const std::vector<St>& b) {
 }
 
 // Ops: set_lane(l, state), get_lane(l) -> state, interleave(src, lanes, m), run(in, out, m),
-// deinterleave(lanes, dst, m),
+// deinterleave(lanes, dst, m), verify(in, n, done) (after the lockstep, before anything is
+// committed: may throw on the input, the lanes having read in[0, done)),
 // snapshot() (overflow counts at the end of the warm-up), commit(l) (lane l's counts of its
 // own outputs into the filter's counters) and scalar(in, out, m, state) (the plain kernel,
 // counting into the filter's counters). Returns how many lanes were recomputed.
@@ -299,6 +300,7 @@ std::size_t time_split(const T* in, T* out, std::size_t n, std::vector<St>& stat
       ops.snapshot();
     }
   }
+  ops.verify(in, n, L * seg + W);  // may throw: nothing is committed yet
   std::vector<St> truth = ops.get_lane(0);  // the state at b_1: lane 0 ran from the true state
   ops.commit(0);
   std::size_t redone = 0;
@@ -363,6 +365,7 @@ struct FloatSplitOps {
   void deinterleave(const batch::LanesF* i, double* const* dst, std::size_t m) {
     batch::deinterleave_batch_float(i, dst, m);
   }
+  void verify(const double*, std::size_t, std::size_t) {}
   void snapshot() {}
   void commit(std::size_t) {}
   void scalar(const double* i, double* o, std::size_t m, std::vector<St>& s) { float_dispatch(i, o, m, c, s); }
@@ -548,7 +551,7 @@ struct FixedSplitOps {
   FixedSplitOps(const BandpassFixed& f, int input_shift, bool bias_ok, OverflowCounter& counter)
       : coef(f.coefficients()), cfg(f.config()), in_scale(std::int64_t{1} << input_shift),
         range(fx_range(f.data_format())), bias(bias_ok), sym(f.sym()), target(counter),
-        b(bandpass_batch_constants(f)) {
+        b(bandpass_batch_constants(f)), filter(f) {
     b.events = ev;
   }
   void set_lane(std::size_t l, const std::vector<St>& s) {
@@ -562,9 +565,17 @@ struct FixedSplitOps {
     for (std::size_t k = 1; k < s.size(); ++k) s[k] = St{b.y1[k - 1].v[l], b.y2[k - 1].v[l], b.y1[k].v[l], b.y2[k].v[l]};
     return s;
   }
+  // The input's range, checked on the lanes' reads (interleave) and the rest in verify().
+  const BandpassFixed& filter;
+  std::int64_t lo = 0, hi = 0;
   void interleave(const std::int64_t* const* src, batch::Lanes* o, std::size_t m) {
-    std::int64_t lo = 0, hi = 0;  // the caller checked the range
     batch::interleave_batch(src, o, m, &lo, &hi);
+  }
+  void verify(const std::int64_t* in, std::size_t n, std::size_t done) {
+    if (lo < fx_min_raw(filter.input_format()) || hi > fx_max_raw(filter.input_format())) {
+      filter.check_input(std::span<const std::int64_t>(in, n));  // throws, naming the first bad sample
+    }
+    filter.check_input(std::span<const std::int64_t>(in + done, n - done));
   }
   void run(const batch::Lanes* i, batch::Lanes* o, std::size_t m) { batch::bandpass_batch(b, i, o, m); }
   void deinterleave(const batch::Lanes* i, std::int64_t* const* dst, std::size_t m) {
@@ -590,7 +601,6 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
                      " differs from input size " + std::to_string(in.size()) + "; they must be equal");
   }
   if (in.empty()) return;
-  check_input(in);  // once per block
   const std::int64_t in_scale = std::int64_t{1} << input_shift_;
   const int qshift = config_.coef_frac;  // acc_frac - data_frac
   const bool long_block = coef_.size() <= static_cast<std::size_t>(batch::kBatchMaxSections) &&
@@ -604,6 +614,7 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
     for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
     return;
   }
+  check_input(in);  // once per block (the split checks on its lanes' reads)
   fx_dispatch(config_.rounding, config_.overflow, [&]<Rounding R, Overflow O>() {
     bandpass_dispatch_sections<R, O>(in.data(), out.data(), in.size(), in_scale, coef_, state_, qshift, data_range_,
                                      section_events_, bias_ok_, sym_ok_);

@@ -143,8 +143,9 @@ class BandpassFixed final : public BandpassFilter {
   std::int64_t execute_raw(std::int64_t x);
   // Block form: out[i] = execute_raw(in[i]) for every i, bit for bit, with the same overflow
   // counts and final state (section_outputs() holds the last sample's). The input range is
-  // checked once for the whole block: an out-of-range sample throws InputError before any
-  // sample is processed (the state is left as it was). Sizes must match (InputError).
+  // checked once for the whole block: an out-of-range sample throws InputError and the state
+  // and the counters are left as they were (a block that takes the time split checks on its
+  // lanes' reads, so `out` may have been written). Sizes must match (InputError).
   // Kernel: sample-major with every section's state in registers (specialized per section
   // count 1..8, rounding and overflow at compile time), so the out-of-order core overlaps
   // the sections' recursions; a long block that does not alias takes the time split
