@@ -551,9 +551,10 @@ std::size_t CorrelatorBankFixed::split_memory() const {
 }
 
 std::size_t CorrelatorBankFixed::split_min_samples() const {
-  // Segments of at least 4 H (the warm-up at most a fifth of the work), and not under 64 Ki.
+  // Segments of at least 2 H (the warm-up at most a third of the lanes' work: a lane sample
+  // costs about a third of a plain one), and not under 16 Ki.
   const std::size_t h = split_memory(), a = std::lcm<std::size_t>(layout_.period, layout_.decimation);
-  return std::max<std::size_t>(std::size_t{1} << 16, h + batch::kBatchLanes * (4 * h + a));
+  return std::max<std::size_t>(std::size_t{1} << 14, h + batch::kBatchLanes * (2 * h + a));
 }
 
 bool CorrelatorBankFixed::feed_split(std::span<const std::int64_t> y, const OutputSink& out) {

@@ -300,7 +300,9 @@ std::size_t ReceiverFixed::execute_block(std::span<const std::int64_t> x, std::v
   // Short chunks stay in the cache; a long block is filtered in long chunks, which the
   // bandpass and the bank run on their SIMD lanes (BandpassSplitStats,
   // CorrelatorBankFixed::feed_split).
-  const std::size_t chunk = x.size() >= kBandpassSplitMin ? std::min(x.size(), 2 * kBandpassSplitMin) : 1024;
+  const std::size_t chunk = x.size() >= std::min(kBandpassSplitMin, bank_.split_min_samples())
+                                ? std::min(x.size(), 2 * kBandpassSplitMin)
+                                : 1024;
   const std::size_t before = events.size();
   if (chunk_.size() < chunk) chunk_.resize(chunk);
   while (!x.empty()) {
