@@ -51,7 +51,7 @@ void collect(const CorrelatorBankFixed& b, std::vector<Output>& out) {
 // The plain run: prefix, block and tail through feed(), every output collected.
 // The split run: prefix through feed(), the block through feed_split, the tail through execute().
 void expect_split_exact(const ReceiverDesign& d, const std::vector<std::int64_t>& y, std::size_t prefix,
-                        std::size_t block, const std::string& what, bool expect_saturation) {
+                        std::size_t block, const std::string& what, bool expect_saturation, std::size_t pieces = 1) {
   CorrelatorBankFixed plain(d.reference, d.config.correlator), split(d.reference, d.config.correlator);
   std::vector<Output> op, os;
   for (std::span<const std::int64_t> rest(y); !rest.empty();) {
@@ -108,7 +108,7 @@ void expect_split_exact(const ReceiverDesign& d, const std::vector<std::int64_t>
   if (expect_saturation) {
     EXPECT_GT(plain.overflow_events().total(), 0u) << what << ": nothing saturated";
   }
-  EXPECT_EQ(split.split_blocks(), took ? 1u : 0u) << what;
+  EXPECT_EQ(split.split_blocks(), took ? pieces : 0u) << what;
   std::printf("[ bank split ] %s: H = %zu, %zu outputs, %llu saturations\n", what.c_str(), split.split_memory(),
               op.size(), static_cast<unsigned long long>(plain.overflow_events().total()));
 }
@@ -157,4 +157,17 @@ TEST(BankSplit, SaturationsAreCountedPerLaneOnlyOnceEach) {
   const std::size_t block = probe.split_min_samples() + 4567;
   const std::vector<std::int64_t> y = bank_input(block + 2000, d.config.bandpass.data_bits, 1.0, 3);
   expect_split_exact(d, y, 77, block, "saturating", true);
+}
+
+TEST(BankSplit, ABlockLongerThanTheOutputBufferIsSplitPieceByPiece) {
+  // 31 codes at D = 4: the lanes' buffered outputs would pass 32 MiB on a block of about 0.5 M
+  // samples, so it goes in pieces (two of split_max_samples() or less, the last at least
+  // split_min_samples()), each with its own warm-ups: still the plain loop, bit for bit.
+  const ReceiverDesign d = design("mseq-5", 4);
+  CorrelatorBankFixed probe(d.reference, d.config.correlator);
+  const std::size_t hi = probe.split_max_samples(), lo = probe.split_min_samples();
+  ASSERT_GE(hi, 2 * lo);
+  const std::size_t block = 2 * hi + 12345;  // hi, then hi + 12345 - lo, then lo
+  const std::vector<std::int64_t> y = bank_input(block + 1000, d.config.bandpass.data_bits, 0.5, 11);
+  expect_split_exact(d, y, 500, block, "mseq-5 D=4 in pieces", false, 3);
 }

@@ -557,9 +557,30 @@ std::size_t CorrelatorBankFixed::split_min_samples() const {
   return std::max<std::size_t>(std::size_t{1} << 14, h + batch::kBatchLanes * (2 * h + a));
 }
 
+std::size_t CorrelatorBankFixed::split_max_samples() const {
+  // The lanes' outputs wait in memory: L (T / D + 1) (codes + 2) words for T lockstep steps,
+  // at most kSplitBufferWords.
+  constexpr std::size_t L = batch::kBatchLanes, kSplitBufferWords = std::size_t{1} << 22;  // 32 MiB
+  const std::size_t per_lane = kSplitBufferWords / (L * (q_.size() + 2));
+  if (per_lane < 2) return 0;
+  const std::size_t steps = (per_lane - 1) * static_cast<std::size_t>(layout_.decimation), h = split_memory();
+  return steps > h ? h + L * (steps - h) : 0;
+}
+
 bool CorrelatorBankFixed::feed_split(std::span<const std::int64_t> y, const OutputSink& out) {
+  const std::size_t lo = split_min_samples(), hi = split_max_samples();
+  if (y.size() < lo || hi < 2 * lo || !batch::batch_kernels_available()) return false;
+  while (y.size() > hi) {  // pieces of lo .. hi samples
+    const std::size_t m = y.size() - hi >= lo ? hi : y.size() - lo;
+    split_piece(y.first(m), out);
+    y = y.subspan(m);
+  }
+  split_piece(y, out);
+  return true;
+}
+
+void CorrelatorBankFixed::split_piece(std::span<const std::int64_t> y, const OutputSink& out) {
   constexpr std::size_t L = batch::kBatchLanes, kStep = 2048;  // lockstep samples at a time
-  if (y.size() < split_min_samples() || !batch::batch_kernels_available()) return false;
   const std::size_t H = split_memory(), a = std::lcm<std::size_t>(layout_.period, layout_.decimation);
   const std::size_t S = (y.size() - H) / (L * a) * a;  // segment: a whole number of lcm(P, D)
   const std::size_t T = H + S;                          // lockstep steps
@@ -649,7 +670,6 @@ bool CorrelatorBankFixed::feed_split(std::span<const std::int64_t> y, const Outp
     if (ready_) out(q_, sample_index(), norm());
   }
   ++split_blocks_;
-  return true;
 }
 
 }  // namespace ranging

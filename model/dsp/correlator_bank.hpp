@@ -175,7 +175,10 @@ class CorrelatorBankFixed {
   bool feed_split(std::span<const std::int64_t> y, const OutputSink& out);
   std::size_t split_memory() const;      // H = max(W, D (f_n + M - 1) + P), rounded up to lcm(P, D)
   std::size_t split_min_samples() const; // the shortest block feed_split takes
-  std::size_t split_blocks() const { return split_blocks_; }  // blocks split since construction
+  // The longest piece split at once: the lanes' outputs wait in at most 32 MiB; a longer block
+  // is split piece by piece (and none is split when this is under twice split_min_samples()).
+  std::size_t split_max_samples() const;
+  std::size_t split_blocks() const { return split_blocks_; }  // pieces split since construction
 
   // Stage taps of the last decimated output, for stage-by-stage comparison with the hardware.
   std::int64_t mix_re() const { return mix_re_; }  // last full-rate mixer output
@@ -243,6 +246,7 @@ class CorrelatorBankFixed {
   std::size_t split_blocks_ = 0;
   friend struct FixedBankLanes;
   void clear_state();  // reset() but the overflow counters and the sample index
+  void split_piece(std::span<const std::int64_t> y, const OutputSink& out);
 };
 
 // The float front end (mixer + one-cycle moving sum + decimation by D) applied to a whole
