@@ -216,7 +216,8 @@ void BM_FloatReceiver(benchmark::State& state) {
 }
 
 // One long stream (the capture tiled to 2^21 samples, as decode's blocks): the bandpass takes
-// its time split on the SIMD lanes (BandpassSplitStats; the label says whether it ran).
+// its time split on the SIMD lanes (BandpassSplitStats), and the fixed bank its own
+// (CorrelatorBankFixed::feed_split); the label says how often each ran.
 template <class Sample>
 std::vector<Sample> tiled(const std::vector<Sample>& v) {
   std::vector<Sample> t;
@@ -236,9 +237,14 @@ void long_stream(benchmark::State& state, const std::vector<Sample>& in) {
     benchmark::DoNotOptimize(ev.data());
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(in.size()));
-  if constexpr (requires { rx.filter().split_stats(); }) {
+  if constexpr (requires { rx.bank().split_blocks(); }) {  // fixed: the bandpass's and the bank's splits
     const auto st = rx.filter().split_stats();
-    state.SetLabel(std::to_string(st.blocks) + " split blocks, " + std::to_string(st.recomputed) + " lanes redone");
+    state.SetLabel("bandpass: " + std::to_string(st.blocks) + " split blocks, " + std::to_string(st.recomputed) +
+                   " lanes redone; bank: " + std::to_string(rx.bank().split_blocks()) + " split blocks");
+  } else if constexpr (requires { rx.filter().split_stats(); }) {
+    const auto st = rx.filter().split_stats();
+    state.SetLabel("bandpass: " + std::to_string(st.blocks) + " split blocks, " + std::to_string(st.recomputed) +
+                   " lanes redone");
   }
 }
 

@@ -133,7 +133,9 @@ class ReceiverFixed {
   // Block form: the same as execute_raw on every x[i] in order, bit for bit (events, state,
   // overflow counts); events are appended to `events` (returns how many). The filter runs a
   // chunk at a time (range checked once per chunk: an out-of-range code throws InputError
-  // before its chunk is processed), then the bank and the detector.
+  // before its chunk changes any state), then the bank and the detector. A long block goes in
+  // long chunks that the filter and the bank each run time-split on the SIMD lanes
+  // (BandpassSplitStats, CorrelatorBankFixed::feed_split); a short one in cache-sized chunks.
   std::size_t execute_block(std::span<const std::int64_t> x, std::vector<EventFixed>& events);
   // x in full-scale units: quantized by quantize_input first; the event in float form.
   std::optional<Event> execute(double x);
