@@ -3,7 +3,7 @@
 // receiver_batch_kernels.hpp): the arrays a batch bank points into, and the fixed bank's
 // constants taken from a CorrelatorBankFixed, in one place for both users:
 //   ReceiverFixedBatch / ReceiverFloatBatch   one stream per lane (receiver_batch.cpp)
-//   CorrelatorBankFixed::feed_all             one long block's segments, one per lane (the
+//   CorrelatorBankFixed::feed_split           one long block's segments, one per lane (the
 //                                             bank's time split, correlator_bank.cpp)
 // Internal to model/dsp (not included by the kernels' translation unit, which sees plain data only).
 #include <cstdint>

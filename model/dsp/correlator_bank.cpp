@@ -609,11 +609,13 @@ void CorrelatorBankFixed::split_piece(std::span<const std::int64_t> y, const Out
   lane0(k.arrays.f_re, f_re_);
   lane0(k.arrays.f_im, f_im_);
 
-  // Every lane's outputs: at most T / D + 1 each.
-  const std::size_t cap = T / static_cast<std::size_t>(layout_.decimation) + 1;
+  // Every lane's outputs: at most T / D + 1 each. They come every D steps, the first at step
+  // f0 (the shared decimation phase) for lane 0 and H + f0 for the others (H is a multiple of D).
+  const std::size_t D = static_cast<std::size_t>(layout_.decimation);
+  const std::size_t f0 = (D - 1 - static_cast<std::size_t>(dec_phase_)) % D;
+  const std::size_t cap = T / D + 1;
   split_q_.resize(L * cap * codes);
   split_norm_.resize(L * cap);
-  split_n_.resize(L * cap);
   std::size_t count[L] = {};
   std::vector<batch::Lanes> in(kStep);
   for (std::size_t t0 = 0; t0 < T;) {
@@ -622,18 +624,16 @@ void CorrelatorBankFixed::split_piece(std::span<const std::int64_t> y, const Out
     for (std::size_t l = 0; l < L; ++l) src[l] = y.data() + l * S + t0;
     std::int64_t lo = 0, hi = 0;
     batch::interleave_batch(src, in.data(), m, &lo, &hi);
-    const std::size_t first = t0 < H ? 1 : L;  // lanes >= 1 keep no output of their warm-up
+    const std::size_t keep = t0 < H ? 1 : L;  // lanes >= 1 keep no output of their warm-up
     for (std::size_t i = 0; i < m;) {
       bool ready = false;
       i += batch::bank_feed_batch(b, in.data() + i, m - i, &ready);
       if (!ready) continue;
-      const std::size_t t = t0 + i - 1;  // the step of the last sample fed
-      for (std::size_t l = 0; l < (t0 < H ? first : L); ++l) {
+      for (std::size_t l = 0; l < keep; ++l) {
         const std::size_t o = l * cap + count[l]++;
         std::uint64_t* q = split_q_.data() + o * codes;
         for (std::size_t j = 0; j < codes; ++j) q[j] = static_cast<std::uint64_t>(b.q[j].v[l]);
         split_norm_[o] = static_cast<std::uint64_t>(b.energy.v[l]) >> layout_.energy_shift;
-        split_n_[o] = n0 + static_cast<std::int64_t>(l * S + t);
       }
     }
     t0 += m;
@@ -645,9 +645,11 @@ void CorrelatorBankFixed::split_piece(std::span<const std::int64_t> y, const Out
     mix_events_ += k.mix_events[l];
     chip_events_ += k.chip_events[l];
     corr_events_ += k.corr_events[l];
+    const std::size_t start = l * S + (l ? H : 0) + f0;  // block offset of lane l's first output
     for (std::size_t i = 0; i < count[l]; ++i) {
       const std::size_t o = l * cap + i;
-      out(std::span<const std::uint64_t>(split_q_.data() + o * codes, codes), split_n_[o], split_norm_[o]);
+      out(std::span<const std::uint64_t>(split_q_.data() + o * codes, codes),
+          n0 + static_cast<std::int64_t>(start + i * D), split_norm_[o]);
     }
   }
 

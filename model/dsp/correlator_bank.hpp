@@ -240,9 +240,9 @@ class CorrelatorBankFixed {
   std::int64_t chip_acc_re_ = 0, chip_acc_im_ = 0;
   std::vector<std::int64_t> comb_re_, comb_im_;
   OverflowCounter mix_events_, chip_events_, corr_events_;
-  // feed_split's scratch: every lane's outputs (Q_j, n, norm), kept for the next block.
+  // feed_split's scratch: every lane's outputs (Q_j, norm; n follows from the phase), kept
+  // for the next block.
   std::vector<std::uint64_t> split_q_, split_norm_;
-  std::vector<std::int64_t> split_n_;
   std::size_t split_blocks_ = 0;
   friend struct FixedBankLanes;
   void clear_state();  // reset() but the overflow counters and the sample index

@@ -313,7 +313,7 @@ std::size_t ReceiverFixed::execute_block(std::span<const std::int64_t> x, std::v
     const auto detect = [&](std::span<const std::uint64_t> q, std::int64_t i, std::uint64_t norm) {
       if (auto e = detector_.execute(q, i, norm)) events.push_back(*e);
     };
-    if (n >= bank_.split_min_samples() && bank_.feed_split(y, detect)) rest = {};  // the bank's time split
+    if (bank_.feed_split(y, detect)) rest = {};  // the bank's time split (long chunks only)
     while (!rest.empty()) {
       rest = rest.subspan(bank_.feed(rest));
       if (bank_.output_ready()) {
