@@ -220,8 +220,39 @@ void float_kernel(const double* in, double* out, std::size_t len, const std::vec
   for (int k = 0; k < S; ++k) st[k] = {x1[k], x2[k], y1[k], y2[k]};
 }
 
+bool ranges_overlap(const void* a, const void* b, std::size_t bytes) {
+  const auto x = reinterpret_cast<std::uintptr_t>(a), y = reinterpret_cast<std::uintptr_t>(b);
+  return x < y + bytes && y < x + bytes;
+}
+
+// The wavefront (batch::bandpass_wave*) pays from this many samples on (its first and last
+// kWaveSkew (N - 1) steps are partly idle).
+constexpr std::size_t kWaveMin = 64;
+
+bool wave_available() {
+  static const bool ok = batch::batch_kernels_available();
+  return ok;
+}
+
+// The wavefront runs a block whose input and output are the same array or do not overlap
+// (it writes out[i] after reading in[i + kWaveSkew (N - 1)]).
+bool wave_fits(const void* in, const void* out, std::size_t bytes, std::size_t len, std::size_t sections) {
+  return len >= kWaveMin && sections <= static_cast<std::size_t>(batch::kBatchMaxSections) &&
+         (in == out || !ranges_overlap(in, out, bytes)) && wave_available();
+}
+
 void float_dispatch(const double* in, double* out, std::size_t len, const std::vector<Biquad>& c,
                     std::vector<BandpassFloat::State>& st) {
+  if (wave_fits(in, out, len * sizeof(double), len, c.size())) {
+    const batch::FloatBandpassBatch k = bandpass_batch_constants(c);
+    batch::WaveStateF w;
+    for (std::size_t j = 0; j < c.size(); ++j) {
+      w.x1.v[j] = st[j].x1, w.x2.v[j] = st[j].x2, w.y1.v[j] = st[j].y1, w.y2.v[j] = st[j].y2;
+    }
+    batch::bandpass_wave_float(k, w, in, out, len);
+    for (std::size_t j = 0; j < c.size(); ++j) st[j] = {w.x1.v[j], w.x2.v[j], w.y1.v[j], w.y2.v[j]};
+    return;
+  }
   switch (c.size()) {
     case 1: return float_kernel<1>(in, out, len, c, st);
     case 2: return float_kernel<2>(in, out, len, c, st);
@@ -252,11 +283,6 @@ constexpr std::size_t kSplitLanes = batch::kBatchLanes;
 constexpr std::size_t kSplitMin = kSplitWarmup + kSplitLanes * 4 * kSplitWarmup;
 constexpr std::size_t kSplitStep = 2048;  // lockstep samples interleaved at a time
 static_assert(kSplitMin == kBandpassSplitMin);
-
-bool ranges_overlap(const void* a, const void* b, std::size_t bytes) {
-  const auto x = reinterpret_cast<std::uintptr_t>(a), y = reinterpret_cast<std::uintptr_t>(b);
-  return x < y + bytes && y < x + bytes;
-}
 
 // The states are plain structs of four 64-bit words: equal means the same bits (a -0.0 is not
 // taken for a +0.0, a NaN is itself).
@@ -536,6 +562,21 @@ void bandpass_dispatch_sections(const std::int64_t* in, std::int64_t* out, std::
 #undef RANGING_BP_CASE
 }
 
+// One block of one stream on the wavefront (batch::bandpass_wave) when it fits; false (nothing
+// done) otherwise. k: the filter's constants (bandpass_batch_constants), s: its state.
+template <class St>
+bool fixed_wave(const batch::BandpassBatch& k, bool bias, const std::int64_t* in, std::int64_t* out, std::size_t m,
+                std::vector<St>& s, OverflowCounter& counter) {
+  if (!wave_fits(in, out, m * sizeof(std::int64_t), m, s.size())) return false;
+  batch::WaveState w;
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    w.x1.v[j] = s[j].x1, w.x2.v[j] = s[j].x2, w.y1.v[j] = s[j].y1, w.y2.v[j] = s[j].y2;
+  }
+  batch::bandpass_wave(k, bias, w, in, out, m, counter);
+  for (std::size_t j = 0; j < s.size(); ++j) s[j] = St{w.x1.v[j], w.x2.v[j], w.y1.v[j], w.y2.v[j]};
+  return true;
+}
+
 // The fixed cascade on the lanes: batch::bandpass_batch (BandpassFixed's arithmetic, exact
 // integers, the same rounding and overflow, counted per lane). St: BandpassFixed::State.
 template <class St>
@@ -587,6 +628,7 @@ struct FixedSplitOps {
     target.wraps += ev[l].wraps - (l ? snap[l].wraps : 0);
   }
   void scalar(const std::int64_t* i, std::int64_t* o, std::size_t m, std::vector<St>& s) {
+    if (fixed_wave(b, bias, i, o, m, s, target)) return;
     fx_dispatch(cfg.rounding, cfg.overflow, [&]<Rounding R, Overflow O>() {
       bandpass_dispatch_sections<R, O>(i, o, m, in_scale, coef, s, cfg.coef_frac, range, target, bias, sym);
     });
@@ -615,6 +657,11 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
     return;
   }
   check_input(in);  // once per block (the split checks on its lanes' reads)
+  if (fixed_wave(bandpass_batch_constants(*this), bias_ok_, in.data(), out.data(), in.size(), state_,
+                 section_events_)) {
+    for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
+    return;
+  }
   fx_dispatch(config_.rounding, config_.overflow, [&]<Rounding R, Overflow O>() {
     bandpass_dispatch_sections<R, O>(in.data(), out.data(), in.size(), in_scale, coef_, state_, qshift, data_range_,
                                      section_events_, bias_ok_, sym_ok_);
@@ -622,15 +669,25 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
   for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
 }
 
+namespace {
+// True when some value is outside [lo, hi]. An AVX-512 clone beside the baseline one (picked at
+// load time): a compare per value, the same answer.
+#if defined(__x86_64__)
+[[gnu::target_clones("default", "arch=x86-64-v4")]]
+#endif
+bool any_outside(const std::int64_t* p, std::size_t n, std::int64_t lo, std::int64_t hi) {
+  // v in [lo, hi] exactly when v - lo (mod 2^64) <= hi - lo: one unsigned maximum
+  const auto ulo = static_cast<std::uint64_t>(lo);
+  std::uint64_t m = 0;
+  for (std::size_t i = 0; i < n; ++i) m = std::max(m, static_cast<std::uint64_t>(p[i]) - ulo);
+  return m > static_cast<std::uint64_t>(hi) - ulo;
+}
+}  // namespace
+
 void BandpassFixed::check_input(std::span<const std::int64_t> in) const {
   if (in.empty()) return;
   const std::int64_t lo = fx_min_raw(input_fmt_), hi = fx_max_raw(input_fmt_);
-  std::int64_t mn = in[0], mx = in[0];
-  for (const std::int64_t v : in) {
-    mn = std::min(mn, v);
-    mx = std::max(mx, v);
-  }
-  if (mn < lo || mx > hi) {
+  if (any_outside(in.data(), in.size(), lo, hi)) {
     for (const std::int64_t v : in) {
       if (v < lo || v > hi) throw_input_range(v);
     }

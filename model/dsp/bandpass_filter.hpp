@@ -111,10 +111,13 @@ class BandpassFloat final : public BandpassFilter {
   void reset() override;
   double execute(double x) override;
   // Block form: out[i] = execute(in[i]) for every i, bit for bit (the same expression per
-  // section, in the same order; section_outputs() then holds the last sample's). The state
-  // lives in locals for the block (specialized for 1..8 sections), so the out-of-order core
-  // overlaps the sections' recursions. Sizes must match (InputError); in and out may alias
-  // (an aliased block never takes the time split: its recomputation needs the input).
+  // section, in the same order; section_outputs() then holds the last sample's). A block of
+  // >= 64 samples with up to 8 sections runs on the wavefront when the CPU has AVX-512
+  // (section k on SIMD lane k, kWaveSkew samples behind section k - 1: the recursions
+  // overlap in one register, receiver_batch_kernels.hpp); otherwise the state lives in locals
+  // (specialized for 1..8 sections) and the out-of-order core overlaps the recursions. Sizes
+  // must match (InputError); in and out may alias (an aliased block never takes the time
+  // split: its recomputation needs the input; a partly overlapping one runs the scalar loop).
   void execute_block(std::span<const double> in, std::span<double> out);
   const std::vector<double>& section_outputs() const { return out_; }
   BandpassSplitStats split_stats() const { return split_; }  // since construction
@@ -146,10 +149,11 @@ class BandpassFixed final : public BandpassFilter {
   // checked once for the whole block: an out-of-range sample throws InputError and the state
   // and the counters are left as they were (a block that takes the time split checks on its
   // lanes' reads, so `out` may have been written). Sizes must match (InputError).
-  // Kernel: sample-major with every section's state in registers (specialized per section
-  // count 1..8, rounding and overflow at compile time), so the out-of-order core overlaps
-  // the sections' recursions; a long block that does not alias takes the time split
-  // (BandpassSplitStats above).
+  // Kernel: the wavefront as BandpassFloat's (>= 64 samples, up to 8 sections, AVX-512; exact
+  // integers, overflows counted only for the lanes whose section has a sample at that step),
+  // else sample-major with every section's state in registers (specialized per section
+  // count 1..8, rounding and overflow at compile time); a long block that does not alias
+  // takes the time split (BandpassSplitStats above).
   using BandpassFilter::execute_block;
   void execute_block(std::span<const std::int64_t> in, std::span<std::int64_t> out);
   // Throws InputError naming the first sample of `in` outside the signed input_bits range.

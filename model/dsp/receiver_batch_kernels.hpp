@@ -117,6 +117,37 @@ std::size_t bank_feed_batch_float(FloatBankBatch& s, const LanesF* in, std::size
 // code order, as the detector's argmax).
 unsigned gate_batch_float(const FloatBankBatch& s, double threshold, double min_energy);
 
+// ---- one stream's cascade on the lanes: the wavefront --------------------------------------
+// Section k of ONE stream runs on lane k (N <= kBatchMaxSections sections), kWaveSkew samples
+// behind section k - 1: at step i lane k computes sample i - kWaveSkew k, from the output lane
+// k - 1 computed kWaveSkew steps before. Every section's sample is the scalar kernel's expression
+// on the same values (BandpassFixed's exact integers, rounding and overflow; BandpassFloat's
+// doubles left to right, no contraction), so the output and the final state are the scalar
+// kernel's bit for bit; only the order in which the CPU meets the operations differs. The skew
+// takes the output of the previous section off the loop-carried path: a step waits on its own
+// lane's y1 only (the a1 y1 product and two subtractions), and the N recursions overlap in one
+// register. The first and last kWaveSkew (N - 1) steps have lanes outside the block: their state
+// is kept (mask blends) and their overflows are not counted. n = 0 is allowed.
+constexpr int kWaveSkew = 3;
+
+// Lane k: section k's state (BandpassFixed::State / BandpassFloat::State): its input history
+// x1, x2 and output history y1, y2. Lanes >= sections are unused.
+struct WaveState {
+  Lanes x1{}, x2{}, y1{}, y2{};
+};
+struct WaveStateF {
+  LanesF x1{}, x2{}, y1{}, y2{};
+};
+
+// out[i] = the cascade of in[i] for i < n (input codes in range: the caller checks), with the
+// constants of c (c's own state and events are not used); `bias`: round half up by a folded
+// 2^(qshift-1) (BandpassFixed's bias_ok: |acc| < 2^61 and qshift >= 1), else c.rounding.
+// Overflows of section outputs are handled by c.overflow and counted in `events`. in and out
+// may be the same array, not otherwise overlapping.
+void bandpass_wave(const BandpassBatch& c, bool bias, WaveState& s, const std::int64_t* in, std::int64_t* out,
+                   std::size_t n, OverflowCounter& events);
+void bandpass_wave_float(const FloatBandpassBatch& c, WaveStateF& s, const double* in, double* out, std::size_t n);
+
 // True when this build has the kernels and the CPU runs them.
 bool batch_kernels_available();
 

@@ -292,6 +292,167 @@ T load_unaligned(const E* p) {
   return v;
 }
 
+// ---- the wavefront: one stream, section k on lane k (receiver_batch_kernels.hpp) ------------
+
+// The lanes of sections whose sample at step i is in the block [0, n): 0 <= i - kWaveSkew k < n.
+inline __mmask8 wave_active(std::size_t i, std::size_t n, int sections) {
+  unsigned m = 0;
+  for (int k = 0; k < sections; ++k) {
+    const std::size_t lag = static_cast<std::size_t>(kWaveSkew) * static_cast<std::size_t>(k);
+    if (i >= lag && i - lag < n) m |= 1u << k;
+  }
+  return static_cast<__mmask8>(m);
+}
+
+// Lane 0 = x, lane k = v[k - 1]: the previous section's output moves one lane up. (The
+// zero-masked forms of the intrinsics: the plain ones trip GCC 12's -Wmaybe-uninitialized.)
+inline V shift_in(V v, std::int64_t x) {
+  return reinterpret_cast<V>(
+      _mm512_maskz_alignr_epi64(__mmask8(0xFF), reinterpret_cast<__m512i>(v), _mm512_set1_epi64(x), 7));
+}
+inline D shift_in(D v, double x) {
+  return reinterpret_cast<D>(_mm512_maskz_alignr_epi64(__mmask8(0xFF), reinterpret_cast<__m512i>(v),
+                                                       reinterpret_cast<__m512i>(_mm512_set1_pd(x)), 7));
+}
+// Lane `lane` of v.
+inline std::int64_t lane_of(V v, int lane) {
+  return reinterpret_cast<V>(_mm512_maskz_permutexvar_epi64(__mmask8(0xFF), _mm512_set1_epi64(lane),
+                                                            reinterpret_cast<__m512i>(v)))[0];
+}
+inline double lane_of(D v, int lane) {
+  return _mm512_cvtsd_f64(
+      _mm512_maskz_permutexvar_pd(__mmask8(0xFF), _mm512_set1_epi64(lane), reinterpret_cast<__m512d>(v)));
+}
+template <class T>
+inline T keep(__mmask8 m, T old, T nw) {  // lanes in m from nw, the others from old
+  return reinterpret_cast<T>(
+      _mm512_mask_blend_epi64(m, reinterpret_cast<__m512i>(old), reinterpret_cast<__m512i>(nw)));
+}
+
+// The wavefront's registers: every section's state (lane k: section k) and the output vectors
+// of the last kWaveSkew steps (p[j]: step i - 1 - j).
+template <class T>
+struct Wave {
+  T x1, x2, y1, y2, p[kWaveSkew];
+};
+
+// The lanes in `bad` brought into range by c.overflow, each counted (out of line: the loop keeps
+// its vectors in registers).
+[[gnu::noinline]] void wave_overflow(V& y, __mmask8 bad, const BandpassBatch& c, OverflowCounter& events) {
+  for (int l = 0; l < kBatchLanes; ++l) {
+    if ((bad >> l) & 1) y[l] = fx_overflow_slow(y[l], c.range, c.overflow, events);
+  }
+}
+
+// The steps [i0, i1) of the wavefront over in[0, n). Masked for the first and last steps: the
+// lanes outside the block get input 0, keep their state and count no overflow.
+template <Rounding R, bool Narrow, bool Sym, bool Bias, bool Masked>
+void wave_steps(const BandpassBatch& c, const V (&co)[5], Wave<V>& w, const std::int64_t* in, std::int64_t* out,
+                std::size_t n, std::size_t i0, std::size_t i1, OverflowCounter& events) {
+  const std::size_t lat = static_cast<std::size_t>(kWaveSkew) * static_cast<std::size_t>(c.sections - 1);
+  const int ish = c.input_shift, qs = c.qshift, last = c.sections - 1;
+  const V bias = splat(Bias ? (std::int64_t{1} << (qs - 1)) : 0);
+  const __m512i lo = _mm512_set1_epi64(c.range.lo), hi = _mm512_set1_epi64(c.range.hi);
+  const V b0 = co[0], b1 = co[1], b2 = co[2], a1 = co[3], a2 = co[4];
+  V x1 = w.x1, x2 = w.x2, y1 = w.y1, y2 = w.y2;  // in registers
+  V p[kWaveSkew];
+  for (int j = 0; j < kWaveSkew; ++j) p[j] = w.p[j];
+  for (std::size_t i = i0; i < i1; ++i) {
+    // = code * 2^input_shift (two's complement, exact in range); 0 past the block's end
+    V x = shift_in(p[kWaveSkew - 1], i < n ? in[i] * (std::int64_t{1} << ish) : 0);
+    __mmask8 act = 0xFF;  // lanes >= sections: coefficients 0, y = 0, never out of range
+    if constexpr (Masked) {
+      act = wave_active(i, n, c.sections);
+      x = reinterpret_cast<V>(_mm512_maskz_mov_epi64(act, reinterpret_cast<__m512i>(x)));
+    }
+    V part;
+    if constexpr (Sym) {
+      part = mul<Narrow>(b0, x - x2) - mul<Narrow>(a2, y2) + bias;
+    } else {
+      part = mul<Narrow>(b0, x) + mul<Narrow>(b1, x1) + mul<Narrow>(b2, x2) - mul<Narrow>(a2, y2) + bias;
+    }
+    const V acc = part - mul<Narrow>(a1, y1);
+    V y = Bias ? acc >> qs : round_shift<R>(acc, qs);
+    const __m512i yi = reinterpret_cast<__m512i>(y);
+    const __mmask8 bad = _mm512_mask_cmplt_epi64_mask(act, yi, lo) | _mm512_mask_cmpgt_epi64_mask(act, yi, hi);
+    if (bad) [[unlikely]] wave_overflow(y, bad, c, events);
+    if constexpr (Masked) {
+      x2 = keep(act, x2, x1);
+      x1 = keep(act, x1, x);
+      y2 = keep(act, y2, y1);
+      y1 = keep(act, y1, y);
+    } else {
+      x2 = x1;
+      x1 = x;
+      y2 = y1;
+      y1 = y;
+    }
+    for (int j = kWaveSkew - 1; j > 0; --j) p[j] = p[j - 1];
+    p[0] = y;
+    if (i >= lat) out[i - lat] = lane_of(y, last);  // the last section's sample i - lat
+  }
+  w.x1 = x1, w.x2 = x2, w.y1 = y1, w.y2 = y2;
+  for (int j = 0; j < kWaveSkew; ++j) w.p[j] = p[j];
+}
+
+template <Rounding R, bool Narrow, bool Sym, bool Bias>
+void wave_kernel(const BandpassBatch& c, WaveState& s, const std::int64_t* in, std::int64_t* out, std::size_t n,
+                 OverflowCounter& events) {
+  V co[5];
+  for (int t = 0; t < 5; ++t) {
+    co[t] = V{};
+    for (int k = 0; k < c.sections; ++k) co[t][k] = c.coef[k][t];  // lanes >= sections: 0
+  }
+  Wave<V> w{load(s.x1), load(s.x2), load(s.y1), load(s.y2), {}};
+  const std::size_t lat = static_cast<std::size_t>(kWaveSkew) * static_cast<std::size_t>(c.sections - 1);
+  // every lane is in the block for the steps [lat, n)
+  const std::size_t m0 = std::min(lat, n + lat), m1 = std::max(lat, n);
+  wave_steps<R, Narrow, Sym, Bias, true>(c, co, w, in, out, n, 0, m0, events);
+  if (n > lat) wave_steps<R, Narrow, Sym, Bias, false>(c, co, w, in, out, n, lat, n, events);
+  wave_steps<R, Narrow, Sym, Bias, true>(c, co, w, in, out, n, m1, n + lat, events);
+  store(s.x1, w.x1);
+  store(s.x2, w.x2);
+  store(s.y1, w.y1);
+  store(s.y2, w.y2);
+}
+
+template <bool Masked>
+void wave_steps_float(const D (&co)[5], Wave<D>& w, int sections, const double* in, double* out, std::size_t n,
+                      std::size_t i0, std::size_t i1) {
+  const std::size_t lat = static_cast<std::size_t>(kWaveSkew) * static_cast<std::size_t>(sections - 1);
+  const int last = sections - 1;
+  const D b0 = co[0], b1 = co[1], b2 = co[2], a1 = co[3], a2 = co[4];
+  D x1 = w.x1, x2 = w.x2, y1 = w.y1, y2 = w.y2;
+  D p[kWaveSkew];
+  for (int j = 0; j < kWaveSkew; ++j) p[j] = w.p[j];
+  for (std::size_t i = i0; i < i1; ++i) {
+    D x = shift_in(p[kWaveSkew - 1], i < n ? in[i] : 0.0);
+    __mmask8 act = 0xFF;
+    if constexpr (Masked) {
+      act = wave_active(i, n, sections);
+      x = reinterpret_cast<D>(_mm512_maskz_mov_pd(act, reinterpret_cast<__m512d>(x)));
+    }
+    // BandpassFloat::execute's expression, left to right
+    const D y = b0 * x + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
+    if constexpr (Masked) {
+      x2 = keep(act, x2, x1);
+      x1 = keep(act, x1, x);
+      y2 = keep(act, y2, y1);
+      y1 = keep(act, y1, y);
+    } else {
+      x2 = x1;
+      x1 = x;
+      y2 = y1;
+      y1 = y;
+    }
+    for (int j = kWaveSkew - 1; j > 0; --j) p[j] = p[j - 1];
+    p[0] = y;
+    if (i >= lat) out[i - lat] = lane_of(y, last);
+  }
+  w.x1 = x1, w.x2 = x2, w.y1 = y1, w.y2 = y2;
+  for (int j = 0; j < kWaveSkew; ++j) w.p[j] = p[j];
+}
+
 }  // namespace
 
 void interleave_batch_float(const double* const* src, double gain, LanesF* out, std::size_t n) {
@@ -489,6 +650,44 @@ std::size_t bank_feed_batch(BankBatch& s, const Lanes* in, std::size_t n, bool* 
   return i;
 }
 
+void bandpass_wave(const BandpassBatch& c, bool bias, WaveState& s, const std::int64_t* in, std::int64_t* out,
+                   std::size_t n, OverflowCounter& events) {
+  auto forms = [&]<Rounding R, bool B>() {
+    if (c.narrow) {
+      c.sym ? wave_kernel<R, true, true, B>(c, s, in, out, n, events)
+            : wave_kernel<R, true, false, B>(c, s, in, out, n, events);
+    } else {
+      c.sym ? wave_kernel<R, false, true, B>(c, s, in, out, n, events)
+            : wave_kernel<R, false, false, B>(c, s, in, out, n, events);
+    }
+  };
+  switch (c.rounding) {
+    case Rounding::Truncate: return forms.template operator()<Rounding::Truncate, false>();
+    case Rounding::RoundHalfUp:
+      return bias ? forms.template operator()<Rounding::RoundHalfUp, true>()
+                  : forms.template operator()<Rounding::RoundHalfUp, false>();
+    default: return forms.template operator()<Rounding::Convergent, false>();
+  }
+}
+
+void bandpass_wave_float(const FloatBandpassBatch& c, WaveStateF& s, const double* in, double* out, std::size_t n) {
+  D co[5];
+  for (int t = 0; t < 5; ++t) {
+    co[t] = D{};
+    for (int k = 0; k < c.sections; ++k) co[t][k] = c.coef[k][t];  // lanes >= sections: 0
+  }
+  Wave<D> w{loadf(s.x1), loadf(s.x2), loadf(s.y1), loadf(s.y2), {}};
+  const std::size_t lat = static_cast<std::size_t>(kWaveSkew) * static_cast<std::size_t>(c.sections - 1);
+  const std::size_t m0 = std::min(lat, n + lat), m1 = std::max(lat, n);
+  wave_steps_float<true>(co, w, c.sections, in, out, n, 0, m0);
+  if (n > lat) wave_steps_float<false>(co, w, c.sections, in, out, n, lat, n);
+  wave_steps_float<true>(co, w, c.sections, in, out, n, m1, n + lat);
+  storef(s.x1, w.x1);
+  storef(s.x2, w.x2);
+  storef(s.y1, w.y1);
+  storef(s.y2, w.y2);
+}
+
 #else  // no AVX-512 build: the kernels are absent
 
 void bandpass_batch_float(FloatBandpassBatch&, const LanesF*, LanesF*, std::size_t) {}
@@ -498,6 +697,9 @@ std::size_t bank_feed_batch_float(FloatBankBatch&, const LanesF*, std::size_t, b
 }
 
 bool batch_kernels_available() { return false; }
+void bandpass_wave(const BandpassBatch&, bool, WaveState&, const std::int64_t*, std::int64_t*, std::size_t,
+                   OverflowCounter&) {}
+void bandpass_wave_float(const FloatBandpassBatch&, WaveStateF&, const double*, double*, std::size_t) {}
 unsigned gate_batch_float(const FloatBankBatch&, double, double) { return ~0u; }
 void interleave_batch_float(const double* const*, double, LanesF*, std::size_t) {}
 void interleave_batch(const std::int64_t* const*, Lanes*, std::size_t, std::int64_t*, std::int64_t*) {}
