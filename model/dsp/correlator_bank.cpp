@@ -208,6 +208,9 @@ std::vector<std::complex<double>> baseband_decimate(std::span<const double> x, i
 CorrelatorBankFloat::CorrelatorBankFloat(const CorrelatorReference& ref)
     : ref_(ref), chips_(static_cast<int>(ref.codes.empty() ? 0 : ref.codes.front().size())) {
   check_reference(ref_);
+  for (const auto& code : ref_.codes) {
+    for (int c = 0; c < chips_; ++c) signs_.push_back(code[static_cast<std::size_t>(c)] ? 1.0 : -1.0);
+  }
   reset();
 }
 
@@ -323,6 +326,142 @@ void CorrelatorBankFloat::decimated_output() {
     q_[j] = (cre * cre + cim * cim) / ref_.code_gain[j];
     c_re_[j] = cre;
     c_im_[j] = cim;
+  }
+}
+
+namespace {
+#if defined(__x86_64__)
+#define RANGING_BANK_CLONES [[gnu::target_clones("default", "arch=x86-64-v4")]]
+#else
+#define RANGING_BANK_CLONES
+#endif
+
+// The chip filter of k consecutive outputs: f[u] = sum over i < m of taps[i] bd[u + m - 1 - i],
+// each sum from 0.0 in i order, product then sum (decimated_output's operations per output;
+// one output per SIMD lane in the AVX-512 clone, picked at load time: the same doubles).
+RANGING_BANK_CLONES void chip_fir_run(const double* taps, std::size_t m, const double* bd, std::size_t k, double* f) {
+  for (std::size_t u = 0; u < k; ++u) f[u] = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const double t = taps[i];
+    const double* b = bd + (m - 1 - i);
+    for (std::size_t u = 0; u < k; ++u) f[u] += t * b[u];
+  }
+}
+
+// The combiner of one code over k consecutive outputs: C[u] = sum over chips c of
+// sign[c] f[u + c step] (from 0.0 in chip order, oldest chip first), Q[u] = (Cre^2 + Cim^2) / gain.
+RANGING_BANK_CLONES void combine_run(const double* sign, std::size_t chips, std::size_t step, const double* fre,
+                                     const double* fim, std::size_t k, double gain, double* cre, double* cim,
+                                     double* q) {
+  for (std::size_t u = 0; u < k; ++u) cre[u] = cim[u] = 0.0;
+  for (std::size_t c = 0; c < chips; ++c) {
+    const double s = sign[c];
+    const double* a = fre + c * step;
+    const double* b = fim + c * step;
+    for (std::size_t u = 0; u < k; ++u) {
+      cre[u] += s * a[u];
+      cim[u] += s * b[u];
+    }
+  }
+  for (std::size_t u = 0; u < k; ++u) q[u] = (cre[u] * cre[u] + cim[u] * cim[u]) / gain;
+}
+
+constexpr std::size_t kOutputRun = 256;  // outputs computed together by feed_outputs
+}  // namespace
+
+void CorrelatorBankFloat::feed_outputs(std::span<const double> in, const OutputSink& out) {
+  if (in.empty()) return;  // as a feed() loop over nothing: nothing changes
+  const std::size_t m = bd_n_, h = f_n_ - 1;  // Bd and F history before a run's first output
+  run_bd_re_.resize(m - 1 + kOutputRun);
+  run_bd_im_.resize(run_bd_re_.size());
+  run_f_re_.resize(h + kOutputRun);
+  run_f_im_.resize(run_f_re_.size());
+  run_e_.resize(kOutputRun);
+  run_n_.resize(kOutputRun);
+  const double* lo_cos = lo_cos_.data();
+  const double* lo_sin = lo_sin_.data();
+  double* b_re = b_re_.data();
+  double* b_im = b_im_.data();
+  double* y2h = y2_.data();
+  const std::size_t period = b_re_.size(), window = y2_.size();
+  const int decimation = ref_.decimation;
+  std::size_t b_idx = b_idx_, y_idx = y_idx_;
+  int dec_phase = dec_phase_;
+  double acc_re = acc_re_, acc_im = acc_im_, energy = energy_;
+  std::size_t k = 0;  // outputs in the run
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    // feed()'s front end, sample by sample
+    const double y = in[i];
+    const double bre = y * lo_cos[b_idx], bim = -y * lo_sin[b_idx];
+    acc_re += bre - b_re[b_idx];
+    acc_im += bim - b_im[b_idx];
+    b_re[b_idx] = bre;
+    b_im[b_idx] = bim;
+    if (++b_idx == period) b_idx = 0;
+    if (++y_idx == window) y_idx = 0;
+    energy += y * y - y2h[y_idx];
+    y2h[y_idx] = y * y;
+    energy = std::max(energy, 0.0);  // running-sum rounding in double
+    if (++dec_phase == decimation) {
+      dec_phase = 0;
+      run_bd_re_[m - 1 + k] = acc_re;
+      run_bd_im_[m - 1 + k] = acc_im;
+      run_e_[k] = energy;
+      run_n_[k] = n_ + static_cast<std::int64_t>(i);
+      if (++k == kOutputRun) {
+        output_run(k, out);
+        k = 0;
+      }
+    }
+  }
+  if (k > 0) output_run(k, out);
+  n_ += static_cast<std::int64_t>(in.size());
+  b_idx_ = b_idx;
+  y_idx_ = y_idx;
+  dec_phase_ = dec_phase;
+  acc_re_ = acc_re;
+  acc_im_ = acc_im;
+  energy_ = energy;
+  ready_ = dec_phase == 0;  // the last sample completed an output
+}
+
+// The k outputs whose decimator values are in run_bd_*[m - 1 ..]: the histories before them
+// come from the rings, the rings take the new values after.
+void CorrelatorBankFloat::output_run(std::size_t k, const OutputSink& out) {
+  const std::size_t m = bd_n_, h = f_n_ - 1, codes = q_.size();
+  const auto chips = static_cast<std::size_t>(chips_);
+  const auto step = static_cast<std::size_t>(ref_.chip_samples / ref_.decimation);
+  // the last m - 1 Bd and h F values, oldest first (each ring's newest slot is idx + n)
+  std::copy_n(bd_re_.data() + bd_idx_ + 2, m - 1, run_bd_re_.data());
+  std::copy_n(bd_im_.data() + bd_idx_ + 2, m - 1, run_bd_im_.data());
+  std::copy_n(f_re_.data() + f_idx_ + 2, h, run_f_re_.data());
+  std::copy_n(f_im_.data() + f_idx_ + 2, h, run_f_im_.data());
+  chip_fir_run(ref_.chip_taps.data(), m, run_bd_re_.data(), k, run_f_re_.data() + h);
+  chip_fir_run(ref_.chip_taps.data(), m, run_bd_im_.data(), k, run_f_im_.data() + h);
+  run_cre_.resize(k);
+  run_cim_.resize(k);
+  run_q_.resize(codes * k);
+  for (std::size_t j = 0; j < codes; ++j) {
+    combine_run(signs_.data() + j * chips, chips, step, run_f_re_.data(), run_f_im_.data(), k, ref_.code_gain[j],
+                run_cre_.data(), run_cim_.data(), run_q_.data() + j * k);
+    c_re_[j] = run_cre_[k - 1];
+    c_im_[j] = run_cim_[k - 1];
+  }
+  for (std::size_t u = 0; u < k; ++u) {
+    if (++bd_idx_ == bd_n_) bd_idx_ = 0;
+    bd_re_[bd_idx_] = bd_re_[bd_idx_ + bd_n_] = run_bd_re_[m - 1 + u];
+    bd_im_[bd_idx_] = bd_im_[bd_idx_ + bd_n_] = run_bd_im_[m - 1 + u];
+    if (++f_idx_ == f_n_) f_idx_ = 0;
+    f_re_[f_idx_] = f_re_[f_idx_ + f_n_] = run_f_re_[h + u];
+    f_im_[f_idx_] = f_im_[f_idx_ + f_n_] = run_f_im_[h + u];
+  }
+  f_last_re_ = run_f_re_[h + k - 1];
+  f_last_im_ = run_f_im_[h + k - 1];
+  for (std::size_t j = 0; j < codes; ++j) q_[j] = run_q_[j * k + k - 1];
+  run_row_.resize(codes);
+  for (std::size_t u = 0; u < k; ++u) {
+    for (std::size_t j = 0; j < codes; ++j) run_row_[j] = run_q_[j * k + u];
+    out(run_row_, run_n_[u], run_e_[u]);
   }
 }
 

@@ -259,16 +259,15 @@ std::size_t ReceiverFloat::execute_block(std::span<const double> x, std::vector<
   double y_small[kChunk];
   if (split && filtered.empty()) long_chunk_.resize(chunk);
   const std::size_t before = events.size();
+  // the bank's outputs in order, straight to the detector (the accessors it reads, handed over)
+  const CorrelatorBankFloat::OutputSink detect = [&](std::span<const double> q, std::int64_t n, double energy) {
+    if (auto e = detector_.execute(q, n, energy)) events.push_back(*e);
+  };
   for (std::size_t n0 = 0; n0 < x.size(); n0 += chunk) {
     const std::size_t len = std::min(chunk, x.size() - n0);
     double* y = !filtered.empty() ? filtered.data() + n0 : split ? long_chunk_.data() : y_small;
     filter_.execute_block(x.subspan(n0, len), std::span<double>(y, len));
-    for (std::span<const double> rest(y, len); !rest.empty();) {
-      rest = rest.subspan(bank_.feed(rest));
-      if (bank_.output_ready()) {
-        if (auto e = detector_.execute(bank_)) events.push_back(*e);
-      }
-    }
+    bank_.feed_outputs(std::span<const double>(y, len), detect);
     filtered_ = y[len - 1];
   }
   return events.size() - before;
