@@ -199,7 +199,8 @@ void BM_FloatBank(benchmark::State& state) {
   for (auto _ : state) {
     bank.reset();
     std::size_t n = 0;
-    bank.feed_outputs(s.filtered_float, [&](std::span<const double>, std::int64_t, double) { ++n; });
+    bank.feed_outputs(s.filtered_float,
+                      [&](std::span<const double>, std::span<const double>, std::int64_t, double) { ++n; });
     benchmark::DoNotOptimize(n);
   }
   items(state);

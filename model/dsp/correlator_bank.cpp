@@ -457,11 +457,16 @@ void CorrelatorBankFloat::output_run(std::size_t k, const OutputSink& out) {
   }
   f_last_re_ = run_f_re_[h + k - 1];
   f_last_im_ = run_f_im_[h + k - 1];
-  for (std::size_t j = 0; j < codes; ++j) q_[j] = run_q_[j * k + k - 1];
-  run_row_.resize(codes);
+  // row 0: the previous output's Q_j, row u + 1: output u's
+  run_rows_.resize((k + 1) * codes);
+  std::copy(q_.begin(), q_.end(), run_rows_.begin());
   for (std::size_t u = 0; u < k; ++u) {
-    for (std::size_t j = 0; j < codes; ++j) run_row_[j] = run_q_[j * k + u];
-    out(run_row_, run_n_[u], run_e_[u]);
+    for (std::size_t j = 0; j < codes; ++j) run_rows_[(u + 1) * codes + j] = run_q_[j * k + u];
+  }
+  std::copy_n(run_rows_.begin() + static_cast<std::ptrdiff_t>(k * codes), codes, q_.begin());
+  for (std::size_t u = 0; u < k; ++u) {
+    const double* prev = run_rows_.data() + u * codes;
+    out(std::span<const double>(prev + codes, codes), std::span<const double>(prev, codes), run_n_[u], run_e_[u]);
   }
 }
 

@@ -105,14 +105,16 @@ class CorrelatorBankFloat {
   std::size_t feed(std::span<const double> y);
   bool output_ready() const { return ready_; }
   // Block form with its outputs handed over: feeds all of y, as feed() over it would, and calls
-  // out(Q_j, n, E) for every decimated output in order (n the full-rate index of its last input,
-  // E its energy: what PeakDetectorFloat::execute reads). The state and the accessors afterwards
+  // out(Q_j, prev, n, E) for every decimated output in order (prev the previous output's Q_j,
+  // zeros before the first, n the full-rate index of its last input, E its energy: what
+  // PeakDetectorFloat::execute reads). The state and the accessors afterwards
   // are feed()'s, bit for bit. The front end runs sample by sample (its running sums are
   // sequential); then the chip filter and the combiner of a run of outputs are computed across
   // the outputs (one output per SIMD lane, each with execute()'s operations in execute()'s
   // order: the same doubles), before the outputs go to `out` (which must not use this bank:
   // its accessors are the block's last output's only at the end). An empty y changes nothing.
-  using OutputSink = std::function<void(std::span<const double> q, std::int64_t n, double energy)>;
+  using OutputSink =
+      std::function<void(std::span<const double> q, std::span<const double> prev, std::int64_t n, double energy)>;
   void feed_outputs(std::span<const double> y, const OutputSink& out);
   const std::vector<double>& weighted_power() const { return q_; }  // Q_j = P_j / K_j
   double energy() const { return energy_; }
@@ -146,8 +148,9 @@ class CorrelatorBankFloat {
   double energy_ = 0, f_last_re_ = 0, f_last_im_ = 0;
   bool ready_ = false;
   std::vector<double> q_, c_re_, c_im_;  // Q_j and C_j of the last output
-  // feed_outputs' buffers: per output Bd, F, E, n (after the histories), C_j and Q_j code-major
-  std::vector<double> run_bd_re_, run_bd_im_, run_f_re_, run_f_im_, run_e_, run_cre_, run_cim_, run_q_, run_row_;
+  // feed_outputs' buffers: per output Bd, F, E, n (after the histories), C_j, Q_j code-major and
+  // Q_j row by row after the previous output's
+  std::vector<double> run_bd_re_, run_bd_im_, run_f_re_, run_f_im_, run_e_, run_cre_, run_cim_, run_q_, run_rows_;
   std::vector<std::int64_t> run_n_;
   std::vector<double> signs_;  // codes x chips: +1.0 for chip 1, -1.0 for chip 0
   void decimated_output();

@@ -78,6 +78,8 @@ class PeakDetectorFloat {
   // gate is closed while idle() skips the call (ReceiverFloatBatch): nothing would change.
   std::optional<Event> execute(std::span<const double> q, std::span<const double> prev, std::int64_t n,
                                double energy);
+  // Records q as the previous output's Q_j (after calls of the prev-given form above).
+  void set_previous(std::span<const double> q) { prev_.assign(q.begin(), q.end()); }
   bool idle() const { return !cand_; }  // no candidate pending
   // The gate of an output whose best code has Q = top: rho^2 = top / E >= threshold, E >= min_energy.
   bool gate(double top, double energy) const {

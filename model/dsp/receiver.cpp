@@ -260,8 +260,9 @@ std::size_t ReceiverFloat::execute_block(std::span<const double> x, std::vector<
   if (split && filtered.empty()) long_chunk_.resize(chunk);
   const std::size_t before = events.size();
   // the bank's outputs in order, straight to the detector (the accessors it reads, handed over)
-  const CorrelatorBankFloat::OutputSink detect = [&](std::span<const double> q, std::int64_t n, double energy) {
-    if (auto e = detector_.execute(q, n, energy)) events.push_back(*e);
+  const CorrelatorBankFloat::OutputSink detect = [&](std::span<const double> q, std::span<const double> prev,
+                                                     std::int64_t n, double energy) {
+    if (auto e = detector_.execute(q, prev, n, energy)) events.push_back(*e);
   };
   for (std::size_t n0 = 0; n0 < x.size(); n0 += chunk) {
     const std::size_t len = std::min(chunk, x.size() - n0);
@@ -270,6 +271,7 @@ std::size_t ReceiverFloat::execute_block(std::span<const double> x, std::vector<
     bank_.feed_outputs(std::span<const double>(y, len), detect);
     filtered_ = y[len - 1];
   }
+  detector_.set_previous(bank_.weighted_power());  // the last output's (zeros before any)
   return events.size() - before;
 }
 

@@ -108,8 +108,9 @@ class ReceiverFloat {
   void reset();
   std::optional<Event> execute(double x);
   // Block form: execute() on every x[i] in order, bit for bit (events, state, filtered()); the
-  // bandpass runs a chunk at a time (BandpassFloat::execute_block), then the bank and the
-  // detector per sample. Events are appended (returns how many); filtered, when not empty
+  // bandpass runs a chunk at a time (BandpassFloat::execute_block), then the bank over the
+  // chunk, handing its outputs to the detector (CorrelatorBankFloat::feed_outputs). Events are
+  // appended (returns how many); filtered, when not empty
   // (its size must be x's, else InputError), receives every bandpass output.
   std::size_t execute_block(std::span<const double> x, std::vector<Event>& events, std::span<double> filtered = {});
   std::optional<Event> flush() { return detector_.flush(); }
