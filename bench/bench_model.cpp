@@ -98,7 +98,9 @@ void BM_FixedBank(benchmark::State& state) {
   for (auto _ : state) {
     bank.reset();
     std::uint64_t outputs = 0;
-    if (!bank.feed_split(s.filtered, [&](std::span<const std::uint64_t>, std::int64_t, std::uint64_t) { ++outputs; })) {
+    if (!bank.feed_split(s.filtered, [&](std::span<const std::uint64_t>, std::span<const std::uint64_t>, std::int64_t, std::uint64_t) {
+          ++outputs;
+        })) {
       std::span<const std::int64_t> rest(s.filtered);
       while (!rest.empty()) {
         rest = rest.subspan(bank.feed(rest));

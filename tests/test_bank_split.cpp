@@ -6,12 +6,15 @@
 // for bit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "model/dsp/quantize.hpp"
 #include "model/dsp/receiver.hpp"
 #include "model/dsp/receiver_batch_kernels.hpp"
 
@@ -64,10 +67,16 @@ void expect_split_exact(const ReceiverDesign& d, const std::vector<std::int64_t>
     if (split.output_ready()) collect(split, os);
   }
   ASSERT_GE(block, split.split_min_samples()) << what;
-  const bool took = split.feed_split(all.subspan(prefix, block), [&](std::span<const std::uint64_t> q, std::int64_t n,
-                                                                       std::uint64_t norm) {
+  std::size_t prev_diff = 0;  // prev handed over: the output before (the bank's last before the block)
+  const std::vector<std::uint64_t> before = split.weighted_power();
+  const bool took = split.feed_split(all.subspan(prefix, block), [&](std::span<const std::uint64_t> q,
+                                                                       std::span<const std::uint64_t> prev,
+                                                                       std::int64_t n, std::uint64_t norm) {
+    const std::vector<std::uint64_t>& want = os.empty() ? before : os.back().q;
+    prev_diff += !std::equal(prev.begin(), prev.end(), want.begin(), want.end());
     os.push_back({std::vector<std::uint64_t>(q.begin(), q.end()), n, norm});
   });
+  EXPECT_EQ(prev_diff, 0u) << what << ": the previous outputs handed over differ";
   EXPECT_EQ(took, batch::batch_kernels_available()) << what;
   if (!took) {  // no SIMD kernels here: the plain loop (the comparison still holds)
     for (std::span<const std::int64_t> rest = all.subspan(prefix, block); !rest.empty();) {
@@ -170,4 +179,41 @@ TEST(BankSplit, ABlockLongerThanTheOutputBufferIsSplitPieceByPiece) {
   const std::size_t block = 2 * hi + 12345;  // hi, then hi + 12345 - lo, then lo
   const std::vector<std::int64_t> y = bank_input(block + 1000, d.config.bandpass.data_bits, 0.5, 11);
   expect_split_exact(d, y, 500, block, "mseq-5 D=4 in pieces", false, 3);
+}
+
+// ReceiverFixed hands the split's outputs to the detector with the previous output's Q_j; the
+// per-sample calls after a split block must find the detector where a per-sample run leaves it.
+// A burst's detection against block boundaries around its correlation peak.
+TEST(BankSplit, PerSampleCallsAfterASplitBlockGiveThePerSampleEvents) {
+  const ReceiverDesign d = design("Gold4", 20);
+  CorrelatorBankFixed probe(d.reference, d.config.correlator);
+  const std::size_t at0 = probe.split_min_samples() + 2000;  // the burst's start
+  const auto& t = d.templates[4];
+  double peak = 0;
+  for (double v : t) peak = std::max(peak, std::abs(v));
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> nz(0.0, 0.01);
+  std::vector<std::int64_t> x(at0 + t.size() + 3000);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double v = (i >= at0 && i < at0 + t.size() ? 0.4 * t[i - at0] / peak : 0.0) + nz(rng);
+    x[i] = quantize_input(v, d.config.bandpass.input_bits, nullptr);
+  }
+  auto run = [&](std::size_t b) {
+    ReceiverFixed rx(d);
+    std::vector<EventFixed> ev;
+    rx.execute_block(std::span<const std::int64_t>(x.data(), b), ev);
+    for (std::size_t i = b; i < x.size(); ++i) {
+      if (auto e = rx.execute_raw(x[i])) ev.push_back(*e);
+    }
+    if (auto e = rx.flush_raw()) ev.push_back(*e);
+    return ev;
+  };
+  const std::vector<EventFixed> ref = run(0);
+  ASSERT_EQ(ref.size(), 1u);
+  EXPECT_EQ(ref[0].code, 5);
+  const auto at = static_cast<std::size_t>(ref[0].arrival >> d.config.detector.frac_bits);
+  ASSERT_GT(at, probe.split_min_samples() + 200);
+  std::size_t diff = 0;
+  for (std::size_t b = at - 120; b <= at + 120; ++b) diff += run(b) != ref;
+  EXPECT_EQ(diff, 0u);
 }

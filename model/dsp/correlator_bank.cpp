@@ -730,6 +730,8 @@ void CorrelatorBankFixed::split_piece(std::span<const std::int64_t> y, const Out
   const std::size_t T = H + S;                          // lockstep steps
   const std::size_t codes = q_.size();
   const std::int64_t n0 = n_;
+  const std::vector<std::uint64_t> before = q_;  // the output before the block's first
+  const std::uint64_t* prev = before.data();
 
   FixedBankLanes k(*this);
   // Lane 0: this bank's state (the lanes share the positions and the phases).
@@ -792,8 +794,10 @@ void CorrelatorBankFixed::split_piece(std::span<const std::int64_t> y, const Out
     const std::size_t start = l * S + (l ? H : 0) + f0;  // block offset of lane l's first output
     for (std::size_t i = 0; i < count[l]; ++i) {
       const std::size_t o = l * cap + i;
-      out(std::span<const std::uint64_t>(split_q_.data() + o * codes, codes),
+      const std::uint64_t* q = split_q_.data() + o * codes;
+      out(std::span<const std::uint64_t>(q, codes), std::span<const std::uint64_t>(prev, codes),
           n0 + static_cast<std::int64_t>(start + i * D), split_norm_[o]);
+      prev = q;
     }
   }
 
@@ -810,10 +814,14 @@ void CorrelatorBankFixed::split_piece(std::span<const std::int64_t> y, const Out
   mix_events_ = mix;
   chip_events_ = chip;
   corr_events_ = corr;
-  // The rest of the block, plainly.
+  // The rest of the block, plainly (q_ now the last lane output's: the re-run ends there).
+  std::vector<std::uint64_t> last = q_;
   for (std::span<const std::int64_t> rest = y.subspan(done); !rest.empty();) {
     rest = rest.subspan(feed(rest));
-    if (ready_) out(q_, sample_index(), norm());
+    if (ready_) {
+      out(q_, last, sample_index(), norm());
+      last = q_;
+    }
   }
   ++split_blocks_;
 }

@@ -189,7 +189,9 @@ class CorrelatorBankFixed {
   // the warm-up lane is in the true state by construction. The outputs wait per lane and go
   // to `out` in sample order; then the bank re-runs the split_memory() samples before the end
   // of the last segment from reset (the same argument) and feeds the rest of the block.
-  using OutputSink = std::function<void(std::span<const std::uint64_t> q, std::int64_t n, std::uint64_t norm)>;
+  // prev: the previous output's Q_j (the bank's weighted_power() before the block for the first).
+  using OutputSink = std::function<void(std::span<const std::uint64_t> q, std::span<const std::uint64_t> prev,
+                                        std::int64_t n, std::uint64_t norm)>;
   bool feed_split(std::span<const std::int64_t> y, const OutputSink& out);
   std::size_t split_memory() const;      // H = max(W, D (f_n + M - 1) + P), rounded up to lcm(P, D)
   std::size_t split_min_samples() const; // the shortest block feed_split takes

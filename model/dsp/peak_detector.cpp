@@ -180,22 +180,26 @@ std::optional<EventFixed> PeakDetectorFixed::execute(const CorrelatorBankFixed& 
 std::optional<EventFixed> PeakDetectorFixed::execute(std::span<const std::uint64_t> q, std::int64_t n,
                                                      std::uint64_t norm) {
   if (prev_.empty()) prev_.assign(q.size(), 0);
+  auto out = execute(q, prev_, n, norm);
+  prev_.assign(q.begin(), q.end());
+  return out;
+}
+
+std::optional<EventFixed> PeakDetectorFixed::execute(std::span<const std::uint64_t> q,
+                                                     std::span<const std::uint64_t> prev, std::int64_t n,
+                                                     std::uint64_t norm) {
   const int best = argmax(q);
   const bool open = gate(q[static_cast<std::size_t>(best)], norm);
-  if (!cand_ && !open) {  // no candidate (most outputs): nothing changes but prev_
-    prev_.assign(q.begin(), q.end());
-    return std::nullopt;
-  }
+  if (!cand_ && !open) return std::nullopt;  // no candidate (most outputs): nothing changes
   const std::uint64_t second = second_best(q, best);
   take_right_neighbour(cand_, q);
   // rho^2 of the best code beats the candidate's: Q / norm > Q_c / norm_c, cross-multiplied.
   const bool better = !cand_ || static_cast<uint128_t>(q[best]) * std::max<std::uint64_t>(cand_->norm, 1) >
                                     static_cast<uint128_t>(cand_->q) * std::max<std::uint64_t>(norm, 1);
-  auto out = next_candidate(cand_, open && better,
-                            Candidate{n, best, prev_[best], q[best], 0, second, norm, false}, n,
-                            holdoff_, [this](const Candidate& c) { return make_event(c); });
-  prev_.assign(q.begin(), q.end());
-  return out;
+  return next_candidate(cand_, open && better,
+                        Candidate{n, best, prev[static_cast<std::size_t>(best)], q[static_cast<std::size_t>(best)], 0,
+                                  second, norm, false},
+                        n, holdoff_, [this](const Candidate& c) { return make_event(c); });
 }
 
 std::optional<EventFixed> PeakDetectorFixed::flush() {

@@ -126,6 +126,11 @@ class PeakDetectorFixed {
   // The same from a decimated output's values: Q_j per code, the full-rate sample index and
   // norm = E >> energy_shift (what the bank overload reads from the bank).
   std::optional<EventFixed> execute(std::span<const std::uint64_t> q, std::int64_t n, std::uint64_t norm);
+  // The same with the previous output's Q_j given (zeros before the first output) instead of
+  // kept by the detector: its own record is neither read nor updated (set_previous after).
+  std::optional<EventFixed> execute(std::span<const std::uint64_t> q, std::span<const std::uint64_t> prev,
+                                    std::int64_t n, std::uint64_t norm);
+  void set_previous(std::span<const std::uint64_t> q) { prev_.assign(q.begin(), q.end()); }
   std::optional<EventFixed> flush();
 
   std::uint64_t threshold_q() const { return thr_q_; }   // on score (score_bits fraction)

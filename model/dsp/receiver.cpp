@@ -311,10 +311,14 @@ std::size_t ReceiverFixed::execute_block(std::span<const std::int64_t> x, std::v
     const std::span<std::int64_t> y(chunk_.data(), n);
     filter_.execute_block(x.first(n), y);
     std::span<const std::int64_t> rest(y);
-    const auto detect = [&](std::span<const std::uint64_t> q, std::int64_t i, std::uint64_t norm) {
-      if (auto e = detector_.execute(q, i, norm)) events.push_back(*e);
+    const auto detect = [&](std::span<const std::uint64_t> q, std::span<const std::uint64_t> prev, std::int64_t i,
+                            std::uint64_t norm) {
+      if (auto e = detector_.execute(q, prev, i, norm)) events.push_back(*e);
     };
-    if (bank_.feed_split(y, detect)) rest = {};  // the bank's time split (long chunks only)
+    if (bank_.feed_split(y, detect)) {  // the bank's time split (long chunks only)
+      rest = {};
+      detector_.set_previous(bank_.weighted_power());  // the last output's
+    }
     while (!rest.empty()) {
       rest = rest.subspan(bank_.feed(rest));
       if (bank_.output_ready()) {
