@@ -254,7 +254,12 @@ bool CorrelatorBankFloat::execute(double y) {
   return ready_;
 }
 
-std::size_t CorrelatorBankFloat::feed(std::span<const double> in) {
+// The front end (mixer, one-cycle moving sum, energy window, decimation) over in[0..], its
+// state in locals: at every sample that completes a decimated output, at_output(i, B_re, B_im,
+// E) (i its index in `in`); stops after that sample when it returns true. Returns how many
+// samples were consumed. The state is stored back at the end.
+template <class AtOutput>
+std::size_t CorrelatorBankFloat::front_end(std::span<const double> in, AtOutput&& at_output) {
   const double* lo_cos = lo_cos_.data();
   const double* lo_sin = lo_sin_.data();
   double* b_re = b_re_.data();
@@ -266,7 +271,6 @@ std::size_t CorrelatorBankFloat::feed(std::span<const double> in) {
   int dec_phase = dec_phase_;
   double acc_re = acc_re_, acc_im = acc_im_, energy = energy_;
   std::size_t i = 0;
-  ready_ = false;
   while (i < in.size()) {
     const double y = in[i++];
     const double bre = y * lo_cos[b_idx], bim = -y * lo_sin[b_idx];
@@ -281,17 +285,22 @@ std::size_t CorrelatorBankFloat::feed(std::span<const double> in) {
     energy = std::max(energy, 0.0);  // running-sum rounding in double
     if (++dec_phase == decimation) {
       dec_phase = 0;
-      ready_ = true;
-      break;
+      if (at_output(i - 1, acc_re, acc_im, energy)) break;
     }
   }
-  n_ += static_cast<std::int64_t>(i);
   b_idx_ = b_idx;
   y_idx_ = y_idx;
   dec_phase_ = dec_phase;
   acc_re_ = acc_re;
   acc_im_ = acc_im;
   energy_ = energy;
+  return i;
+}
+
+std::size_t CorrelatorBankFloat::feed(std::span<const double> in) {
+  ready_ = false;
+  const std::size_t i = front_end(in, [this](std::size_t, double, double, double) { return ready_ = true; });
+  n_ += static_cast<std::int64_t>(i);
   if (ready_) decimated_output();
   return i;
 }
@@ -378,51 +387,21 @@ void CorrelatorBankFloat::feed_outputs(std::span<const double> in, const OutputS
   run_f_im_.resize(run_f_re_.size());
   run_e_.resize(kOutputRun);
   run_n_.resize(kOutputRun);
-  const double* lo_cos = lo_cos_.data();
-  const double* lo_sin = lo_sin_.data();
-  double* b_re = b_re_.data();
-  double* b_im = b_im_.data();
-  double* y2h = y2_.data();
-  const std::size_t period = b_re_.size(), window = y2_.size();
-  const int decimation = ref_.decimation;
-  std::size_t b_idx = b_idx_, y_idx = y_idx_;
-  int dec_phase = dec_phase_;
-  double acc_re = acc_re_, acc_im = acc_im_, energy = energy_;
   std::size_t k = 0;  // outputs in the run
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    // feed()'s front end, sample by sample
-    const double y = in[i];
-    const double bre = y * lo_cos[b_idx], bim = -y * lo_sin[b_idx];
-    acc_re += bre - b_re[b_idx];
-    acc_im += bim - b_im[b_idx];
-    b_re[b_idx] = bre;
-    b_im[b_idx] = bim;
-    if (++b_idx == period) b_idx = 0;
-    if (++y_idx == window) y_idx = 0;
-    energy += y * y - y2h[y_idx];
-    y2h[y_idx] = y * y;
-    energy = std::max(energy, 0.0);  // running-sum rounding in double
-    if (++dec_phase == decimation) {
-      dec_phase = 0;
-      run_bd_re_[m - 1 + k] = acc_re;
-      run_bd_im_[m - 1 + k] = acc_im;
-      run_e_[k] = energy;
-      run_n_[k] = n_ + static_cast<std::int64_t>(i);
-      if (++k == kOutputRun) {
-        output_run(k, out);
-        k = 0;
-      }
+  front_end(in, [&](std::size_t i, double acc_re, double acc_im, double energy) {
+    run_bd_re_[m - 1 + k] = acc_re;
+    run_bd_im_[m - 1 + k] = acc_im;
+    run_e_[k] = energy;
+    run_n_[k] = n_ + static_cast<std::int64_t>(i);
+    if (++k == kOutputRun) {  // (output_run reads none of the front end's state)
+      output_run(k, out);
+      k = 0;
     }
-  }
+    return false;
+  });
   if (k > 0) output_run(k, out);
   n_ += static_cast<std::int64_t>(in.size());
-  b_idx_ = b_idx;
-  y_idx_ = y_idx;
-  dec_phase_ = dec_phase;
-  acc_re_ = acc_re;
-  acc_im_ = acc_im;
-  energy_ = energy;
-  ready_ = dec_phase == 0;  // the last sample completed an output
+  ready_ = dec_phase_ == 0;  // the last sample completed an output
 }
 
 // The k outputs whose decimator values are in run_bd_*[m - 1 ..]: the histories before them

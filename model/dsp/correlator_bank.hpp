@@ -155,6 +155,8 @@ class CorrelatorBankFloat {
   std::vector<double> signs_;  // codes x chips: +1.0 for chip 1, -1.0 for chip 0
   void decimated_output();
   void output_run(std::size_t k, const OutputSink& out);
+  template <class AtOutput>
+  std::size_t front_end(std::span<const double> in, AtOutput&& at_output);
 };
 
 class CorrelatorBankFixed {

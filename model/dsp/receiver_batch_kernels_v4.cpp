@@ -336,6 +336,25 @@ struct Wave {
   T x1, x2, y1, y2, p[kWaveSkew];
 };
 
+// After a step with input x and output y: the lanes in act (every lane unless Masked) take the
+// new sample into their histories, the others keep theirs; y becomes the newest output vector.
+template <bool Masked, class T>
+inline void wave_advance(__mmask8 act, T x, T y, T& x1, T& x2, T& y1, T& y2, T (&p)[kWaveSkew]) {
+  if constexpr (Masked) {
+    x2 = keep(act, x2, x1);
+    x1 = keep(act, x1, x);
+    y2 = keep(act, y2, y1);
+    y1 = keep(act, y1, y);
+  } else {
+    x2 = x1;
+    x1 = x;
+    y2 = y1;
+    y1 = y;
+  }
+  for (int j = kWaveSkew - 1; j > 0; --j) p[j] = p[j - 1];
+  p[0] = y;
+}
+
 // The lanes in `bad` brought into range by c.overflow, each counted (out of line: the loop keeps
 // its vectors in registers).
 [[gnu::noinline]] void wave_overflow(V& y, __mmask8 bad, const BandpassBatch& c, OverflowCounter& events) {
@@ -376,19 +395,7 @@ void wave_steps(const BandpassBatch& c, const V (&co)[5], Wave<V>& w, const std:
     const __m512i yi = reinterpret_cast<__m512i>(y);
     const __mmask8 bad = _mm512_mask_cmplt_epi64_mask(act, yi, lo) | _mm512_mask_cmpgt_epi64_mask(act, yi, hi);
     if (bad) [[unlikely]] wave_overflow(y, bad, c, events);
-    if constexpr (Masked) {
-      x2 = keep(act, x2, x1);
-      x1 = keep(act, x1, x);
-      y2 = keep(act, y2, y1);
-      y1 = keep(act, y1, y);
-    } else {
-      x2 = x1;
-      x1 = x;
-      y2 = y1;
-      y1 = y;
-    }
-    for (int j = kWaveSkew - 1; j > 0; --j) p[j] = p[j - 1];
-    p[0] = y;
+    wave_advance<Masked>(act, x, y, x1, x2, y1, y2, p);
     if (i >= lat) out[i - lat] = lane_of(y, last);  // the last section's sample i - lat
   }
   w.x1 = x1, w.x2 = x2, w.y1 = y1, w.y2 = y2;
@@ -434,19 +441,7 @@ void wave_steps_float(const D (&co)[5], Wave<D>& w, int sections, const double* 
     }
     // BandpassFloat::execute's expression, left to right
     const D y = b0 * x + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2;
-    if constexpr (Masked) {
-      x2 = keep(act, x2, x1);
-      x1 = keep(act, x1, x);
-      y2 = keep(act, y2, y1);
-      y1 = keep(act, y1, y);
-    } else {
-      x2 = x1;
-      x1 = x;
-      y2 = y1;
-      y1 = y;
-    }
-    for (int j = kWaveSkew - 1; j > 0; --j) p[j] = p[j - 1];
-    p[0] = y;
+    wave_advance<Masked>(act, x, y, x1, x2, y1, y2, p);
     if (i >= lat) out[i - lat] = lane_of(y, last);
   }
   w.x1 = x1, w.x2 = x2, w.y1 = y1, w.y2 = y2;
