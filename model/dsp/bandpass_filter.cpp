@@ -563,11 +563,13 @@ void bandpass_dispatch_sections(const std::int64_t* in, std::int64_t* out, std::
 }
 
 // One block of one stream on the wavefront (batch::bandpass_wave) when it fits; false (nothing
-// done) otherwise. k: the filter's constants (bandpass_batch_constants), s: its state.
-template <class St>
-bool fixed_wave(const batch::BandpassBatch& k, bool bias, const std::int64_t* in, std::int64_t* out, std::size_t m,
+// done) otherwise. constants(): the filter's (bandpass_batch_constants; asked only when the
+// block fits, so never for more sections than the kernels hold), s: its state.
+template <class St, class Constants>
+bool fixed_wave(Constants&& constants, bool bias, const std::int64_t* in, std::int64_t* out, std::size_t m,
                 std::vector<St>& s, OverflowCounter& counter) {
   if (!wave_fits(in, out, m * sizeof(std::int64_t), m, s.size())) return false;
+  const batch::BandpassBatch k = constants();
   batch::WaveState w;
   for (std::size_t j = 0; j < s.size(); ++j) {
     w.x1.v[j] = s[j].x1, w.x2.v[j] = s[j].x2, w.y1.v[j] = s[j].y1, w.y2.v[j] = s[j].y2;
@@ -628,7 +630,7 @@ struct FixedSplitOps {
     target.wraps += ev[l].wraps - (l ? snap[l].wraps : 0);
   }
   void scalar(const std::int64_t* i, std::int64_t* o, std::size_t m, std::vector<St>& s) {
-    if (fixed_wave(b, bias, i, o, m, s, target)) return;
+    if (fixed_wave([this] { return b; }, bias, i, o, m, s, target)) return;
     fx_dispatch(cfg.rounding, cfg.overflow, [&]<Rounding R, Overflow O>() {
       bandpass_dispatch_sections<R, O>(i, o, m, in_scale, coef, s, cfg.coef_frac, range, target, bias, sym);
     });
@@ -657,8 +659,8 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
     return;
   }
   check_input(in);  // once per block (the split checks on its lanes' reads)
-  if (fixed_wave(bandpass_batch_constants(*this), bias_ok_, in.data(), out.data(), in.size(), state_,
-                 section_events_)) {
+  if (fixed_wave([this] { return bandpass_batch_constants(*this); }, bias_ok_, in.data(), out.data(), in.size(),
+                 state_, section_events_)) {
     for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
     return;
   }
@@ -717,9 +719,19 @@ SosFilter BandpassFixed::quantized_filter() const {
   return q;
 }
 
+namespace {
+void require_batch_sections(std::size_t n) {
+  if (n > static_cast<std::size_t>(batch::kBatchMaxSections)) {
+    throw InputError("bandpass_batch_constants: " + std::to_string(n) + " sections; the SIMD kernels hold 1.." +
+                     std::to_string(batch::kBatchMaxSections));
+  }
+}
+}  // namespace
+
 batch::BandpassBatch bandpass_batch_constants(const BandpassFixed& filter) {
   const auto& cfg = filter.config();
   const auto& coef = filter.coefficients();
+  require_batch_sections(coef.size());
   batch::BandpassBatch b;
   b.sections = static_cast<int>(coef.size());
   for (std::size_t k = 0; k < coef.size(); ++k) {
@@ -739,6 +751,7 @@ batch::BandpassBatch bandpass_batch_constants(const BandpassFixed& filter) {
 }
 
 batch::FloatBandpassBatch bandpass_batch_constants(const std::vector<Biquad>& sections) {
+  require_batch_sections(sections.size());
   batch::FloatBandpassBatch b;
   b.sections = static_cast<int>(sections.size());
   for (std::size_t k = 0; k < sections.size(); ++k) {

@@ -91,7 +91,9 @@ struct BandpassSplitBackoff {  // the filter's back-off (kept by reset(): the in
 // The SIMD kernels' constants of a cascade (receiver_batch_kernels.hpp), zero state, no event
 // counters: the float coefficients; for the fixed filter also its shifts, rounding, overflow,
 // data range, one-multiply form and whether every factor fits a 32 x 32 multiply. What
-// ReceiverFixedBatch / ReceiverFloatBatch and the time split run. Defined after the classes.
+// ReceiverFixedBatch / ReceiverFloatBatch, the time split and the wavefront run. The kernels
+// hold at most batch::kBatchMaxSections sections: a longer cascade throws InputError (the
+// callers run such a cascade on the scalar kernel). Defined after the classes.
 class BandpassFixed;
 batch::BandpassBatch bandpass_batch_constants(const BandpassFixed& filter);
 batch::FloatBandpassBatch bandpass_batch_constants(const std::vector<Biquad>& sections);
