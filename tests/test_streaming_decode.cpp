@@ -153,6 +153,36 @@ TEST(StreamingDecode, SeveralThreadsGiveTheSameDetections) {
   }
 }
 
+// The receiver runs with the metrics beside it, a burst's metrics waiting until no later event
+// can start before its T_d end (SceneSimulator::set_event_lookback). The derived bound holds:
+// one pass. A bound that events break (negative: bursts settle before the events that end their
+// T_d search, and samples leave the window before later bursts read them) must send the decode
+// to its second pass, which recomputes the metrics with every event known: the same detections.
+TEST(StreamingDecode, ABrokenLookbackBoundFallsBackToTheSecondPass) {
+  const std::string p = write("lookback.wav", capture_wav(capture(), WavFormat::Float32));
+  const Capture whole = read_capture(p);
+  for (const std::string precision : {"float", "fixed"}) {
+    SceneSimulator sim(decode_scene(precision));
+    const auto ref = sim.decode("Gold4", whole.samples, whole.t0, 0.002);
+    ASSERT_GE(ref.size(), 10u);
+    CaptureSource src(p);
+    for (std::optional<long> lookback : {std::optional<long>{}, std::optional<long>{-30000}}) {
+      sim.set_event_lookback(lookback);
+      for (int jobs : {1, 2}) {
+        sim.set_jobs(jobs);
+        for (std::size_t block : {std::size_t{997}, std::size_t{8192}}) {
+          SCOPED_TRACE(precision + ", lookback " + (lookback ? std::to_string(*lookback) : "derived") + ", jobs " +
+                       std::to_string(jobs) + ", block " + std::to_string(block));
+          std::size_t blocks = 0;
+          expect_same(ref, sim.decode_stream("Gold4", src, 0.002, block, {}, [&](std::span<const double>) { ++blocks; }));
+          EXPECT_EQ(blocks, (whole.samples.size() + block - 1) / block) << "the scan sees each block once";
+          EXPECT_EQ(sim.decode_passes(), lookback ? 2 : 1);
+        }
+      }
+    }
+  }
+}
+
 TEST(StreamingDecode, Pcm16WavAndCsvEqualWholeFile) {
   check_file(write("train16.wav", capture_wav(capture(), WavFormat::Pcm16, 0.5)), "fixed");
   // the formats other simulators write (numpy int32 / float64, 8-bit audio)

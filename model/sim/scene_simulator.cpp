@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <set>
 #include <numbers>
 #include <sstream>
 #include <thread>
@@ -397,36 +398,62 @@ struct SceneSimulator::Link {
   }
 
   // receive() over a capture read in blocks, events only (the filtered stream is not kept).
-  std::vector<Event> receive_events(CaptureSource& src, double scale, std::size_t block,
-                                    const std::function<void(std::span<const double>)>& on_block) {
-    std::vector<Event> ev;
-    const double inv = 1.0 / scale;
-    std::vector<double> x(block);
-    src.rewind();
-    if (!fixed()) {
-      ReceiverFloat rf(design);
-      for (std::size_t k; (k = src.read(x)) > 0;) {
-        if (on_block) on_block(std::span<const double>(x.data(), k));
-        for (std::size_t i = 0; i < k; ++i) x[i] *= inv;
-        rf.execute_block(std::span<const double>(x.data(), k), ev);
+  // The receiver of the scene's precision over a stream handed over a block at a time
+  // (decode_stream): block() is receive()'s loop on the next samples, bit for bit, finish()
+  // after the last (the detector's pending candidate).
+  class StreamReceiver {
+   public:
+    StreamReceiver(const Link& lk, double scale) : lk_(lk), scale_(scale), inv_(1.0 / scale) {
+      if (lk.fixed()) {
+        rx_.emplace(lk.design);
+      } else {
+        rf_.emplace(lk.design);
       }
-      if (auto e = rf.flush()) ev.push_back(*e);
-    } else {
-      ReceiverFixed rx(design);
-      OverflowCounter adc;
-      std::vector<std::int64_t> raw(block);
-      std::vector<EventFixed> raw_events;
-      for (std::size_t k; (k = src.read(x)) > 0;) {
-        if (on_block) on_block(std::span<const double>(x.data(), k));
-        for (std::size_t i = 0; i < k; ++i) {
-          raw[i] = quantize_input(std::clamp(x[i] * inv, -1.0, 1.0), design.config.bandpass.input_bits, &adc);
-        }
-        rx.execute_block(std::span<const std::int64_t>(raw.data(), k), raw_events);
-      }
-      for (const auto& e : raw_events) ev.push_back(rx.to_float(e));
-      if (auto e = rx.flush()) ev.push_back(*e);
     }
-    return ev;
+    // x: the next samples in capture units (the float receiver scales them in place); events
+    // are appended to ev; filtered (float receiver only; empty, or x's size) receives the
+    // bandpass output in capture units, as receive() gives it.
+    void block(std::span<double> x, std::vector<Event>& ev, std::span<double> filtered) {
+      if (rf_) {
+        for (double& v : x) v *= inv_;
+        rf_->execute_block(x, ev, filtered);
+        for (double& v : filtered) v *= scale_;
+        return;
+      }
+      raw_.resize(x.size());
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        raw_[i] = quantize_input(std::clamp(x[i] * inv_, -1.0, 1.0), lk_.design.config.bandpass.input_bits, &adc_);
+      }
+      raw_events_.clear();
+      rx_->execute_block(std::span<const std::int64_t>(raw_.data(), x.size()), raw_events_);
+      for (const auto& e : raw_events_) ev.push_back(rx_->to_float(e));
+    }
+    void finish(std::vector<Event>& ev) {
+      if (auto e = rf_ ? rf_->flush() : rx_->flush()) ev.push_back(*e);
+    }
+
+   private:
+    const Link& lk_;
+    double scale_, inv_;
+    std::optional<ReceiverFloat> rf_;
+    std::optional<ReceiverFixed> rx_;
+    OverflowCounter adc_;
+    std::vector<std::int64_t> raw_;
+    std::vector<EventFixed> raw_events_;
+  };
+
+  // Once the receiver has read P samples of a stream, every event it emits later has its
+  // template start (prepare()) at or after P - event_lookback(): a candidate is released at the
+  // first output holdoff samples after it unless a later one replaces it, so a pending one
+  // sits within holdoff + D samples of P, a later one at P or after; the parabola moves the
+  // arrival by D/2 at most; the start is the arrival less the code's calibrated latency.
+  long event_lookback() const {
+    const DetectorConfig& dc = design.config.detector;
+    const long hold = dc.holdoff != -1 ? dc.holdoff : std::max(design.reference.window, design.layout.window);
+    const long dec = std::max(design.reference.decimation, design.layout.decimation);
+    double off = 0;
+    for (double o : offset) off = std::max(off, o);
+    return hold + 2 * dec + static_cast<long>(std::ceil(off)) + 4;
   }
 
   std::size_t stream_tail() const { return static_cast<std::size_t>((3 * L + 6) * spc) + 2000; }
@@ -560,38 +587,47 @@ struct SceneSimulator::Link {
   // n: the stream's length. T_d of a burst is searched up to the next detected burst's start (or
   // the stream's end); ToF against the latest send of the event's code at or before its arrival.
   std::vector<Pending> prepare(const std::vector<Event>& ev, long n, double t0, const std::vector<Burst>& schedule) {
-    std::vector<long> starts;
-    for (const auto& e : ev) starts.push_back(std::lround(e.arrival - offset[static_cast<std::size_t>(e.code - 1)]));
-    std::vector<long> sorted = starts;
+    std::vector<long> sorted;
+    for (const auto& e : ev) sorted.push_back(start_of(e));
     std::sort(sorted.begin(), sorted.end());
-    std::map<int, std::vector<double>> sends;  // per code, sorted
-    for (const auto& b : schedule) sends[b.code].push_back(b.tx_s);
-    for (auto& [code, v] : sends) std::sort(v.begin(), v.end());
+    const auto sends = send_times(schedule);
     std::vector<Pending> out;
-    for (std::size_t k = 0; k < ev.size(); ++k) {
-      const Event& e = ev[k];
-      Pending p;
-      p.start = 0;
-      p.end = n;
-      if (auto it = std::upper_bound(sorted.begin(), sorted.end(), starts[k]); it != sorted.end() && *it < n) {
-        p.end = *it;
+    for (const Event& e : ev) {
+      long end = n;
+      if (auto it = std::upper_bound(sorted.begin(), sorted.end(), start_of(e)); it != sorted.end() && *it < n) {
+        end = *it;
       }
-      Detection& d = p.d;
-      d.code = e.code;
-      d.score = e.score;
-      d.detector_margin = e.margin;
-      const double a = e.arrival - offset[static_cast<std::size_t>(e.code - 1)];
-      d.arrival_s = t0 + a / fs();
-      double tx = 0;
-      if (auto sit = sends.find(e.code); sit != sends.end()) {
-        const auto& v = sit->second;
-        if (auto it = std::upper_bound(v.begin(), v.end(), d.arrival_s); it != v.begin()) tx = *(it - 1);
-      }
-      d.tof_s = d.arrival_s - tx;
-      p.start = std::lround(a);
-      out.push_back(std::move(p));
+      out.push_back(pending(e, end, t0, sends));
     }
     return out;
+  }
+  // An event's template start (its arrival less the code's calibrated latency), samples.
+  long start_of(const Event& e) const { return std::lround(e.arrival - offset[static_cast<std::size_t>(e.code - 1)]); }
+  // The schedule's send times per code, sorted.
+  static std::map<int, std::vector<double>> send_times(const std::vector<Burst>& schedule) {
+    std::map<int, std::vector<double>> sends;
+    for (const auto& b : schedule) sends[b.code].push_back(b.tx_s);
+    for (auto& [code, v] : sends) std::sort(v.begin(), v.end());
+    return sends;
+  }
+  // One event as a detection before its metrics, its T_d searched up to `end`.
+  Pending pending(const Event& e, long end, double t0, const std::map<int, std::vector<double>>& sends) const {
+    Pending p;
+    p.end = end;
+    Detection& d = p.d;
+    d.code = e.code;
+    d.score = e.score;
+    d.detector_margin = e.margin;
+    const double a = e.arrival - offset[static_cast<std::size_t>(e.code - 1)];
+    d.arrival_s = t0 + a / fs();
+    double tx = 0;
+    if (auto sit = sends.find(e.code); sit != sends.end()) {
+      const auto& v = sit->second;
+      if (auto it = std::upper_bound(v.begin(), v.end(), d.arrival_s); it != v.begin()) tx = *(it - 1);
+    }
+    d.tof_s = d.arrival_s - tx;
+    p.start = std::lround(a);
+    return p;
   }
 
   // The paper's metrics of the burst whose template starts at `start`, T_d searched to `end`.
@@ -1117,83 +1153,151 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
   const std::vector<Burst> schedule =
       decode_schedule(lk.design.family.eta(), t0 + static_cast<double>(src.size()) / scene_.fs, period_s);
   const double scale = peak / 0.5;
-  // Pass 2: the receiver's events.
-  const auto ev = lk.receive_events(src, scale, block, on_block);
   const long s0 = std::lround(t0 * scene_.fs);
-  auto pend = lk.prepare(ev, n, static_cast<double>(s0) / scene_.fs, schedule);
-  if (!scene_.receiver.metrics.any()) {  // no metric named: no third pass (the fields set to NaN)
-    std::vector<Detection> out;
-    for (auto& p : pend) {
-      (void)lk.metrics_window(p.d, {}, 0, n, p.start, p.end, *lk.bank);
-      out.push_back(std::move(p.d));
-    }
-    return out;
-  }
-  // Pass 3: the filtered stream (receive()'s, in capture units) through a sliding window that
-  // holds what the bursts whose metrics are pending need (Link::need), oldest first.
-  std::vector<Link::Need> needs;
-  for (const auto& p : pend) needs.push_back(lk.need(n, p.start));
-  std::vector<std::size_t> order(pend.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return needs[a].lo < needs[b].lo; });
-  std::vector<std::size_t> active;
-  std::size_t next = 0;
-  std::vector<double> w;  // f[base, base + w.size())
-  long base = 0;
-  BandpassFloat bp(lk.design.filter);
-  const double inv = 1.0 / scale;
+  const double t0s = static_cast<double>(s0) / scene_.fs;
+  const auto sends = Link::send_times(schedule);
+  const bool metrics = scene_.receiver.metrics.any();
   const bool fixed = lk.fixed();
-  // jobs_ - 1 more matched-filter banks for the worker threads (this thread uses lk.bank)
-  std::vector<std::unique_ptr<PearsonBank>> banks;
-  if (scene_.receiver.metrics.pearson) {
-    for (int t = 1; t < jobs_; ++t) banks.push_back(std::make_unique<PearsonBank>(lk.templates));
-  }
-  src.rewind();
-  for (std::size_t k; (k = src.read(x)) > 0;) {
-    // The block form (bit for bit execute() per sample); scaled as receive() scales.
-    const std::size_t w0 = w.size();
-    w.resize(w0 + k);
-    const std::span<double> wk(w.data() + w0, k);
-    if (fixed) {
-      bp.execute_block(std::span<const double>(x.data(), k), wk);
-    } else {
-      // scaled in place in x (read again next block), so the filter's input and output do not
-      // alias: a long block then runs on the SIMD lanes (BandpassSplitStats)
-      for (std::size_t i = 0; i < k; ++i) x[i] *= inv;
-      bp.execute_block(std::span<const double>(x.data(), k), wk);
-      for (double& v : wk) v *= scale;
+  // The receiver's pass, with the bursts' metrics beside it: each block runs the receiver (and
+  // at fixed precision the metrics' float filter) on one thread while the bursts whose window of
+  // the filtered stream (receive()'s, in capture units) is in run on the others, each with its
+  // own PearsonBank. The window holds what the bursts still pending need (Link::need), oldest
+  // first. A burst's T_d search ends at the next burst's start, so a burst waits until no later
+  // event can start before that (Link::event_lookback). An event that breaks that bound (the
+  // bound is derived, and checked) makes a second pass recompute the metrics with every event
+  // known (`known`: the first pass's events; the receiver's own are dropped then).
+  std::vector<Event> ev;
+  std::vector<Link::Pending> result;
+  auto pass = [&](const std::vector<Event>* known) -> bool {
+    std::vector<Event> got;  // the receiver's events (the second pass drops them)
+    std::vector<long> starts;
+    std::multiset<long> sorted;  // every start so far
+    std::vector<Link::Pending> pend;
+    std::vector<Link::Need> needs;
+    std::vector<std::size_t> open, active;  // end unknown yet / metrics pending
+    long floor_used = std::numeric_limits<long>::min();  // the largest bound a burst relied on
+    bool exact = true;
+    std::vector<double> w, fnext(metrics ? block : 0);  // w = f[base, base + w.size())
+    long base = 0, read = 0;
+    auto add_events = [&](const std::vector<Event>& from, std::size_t i0) {
+      for (std::size_t i = i0; i < from.size(); ++i) {
+        const long st = lk.start_of(from[i]);
+        if (st < floor_used) exact = false;
+        starts.push_back(st);
+        sorted.insert(st);
+        pend.emplace_back();
+        needs.emplace_back();
+        open.push_back(starts.size() - 1);
+      }
+    };
+    // the events whose T_d end is known: every later start is >= floor (all: none comes later)
+    auto settle = [&](const std::vector<Event>& from, long floor, bool all) {
+      std::erase_if(open, [&](std::size_t i) {
+        long end = n;
+        if (auto it = sorted.upper_bound(starts[i]); it != sorted.end() && *it < n) end = *it;
+        if (!all && end > floor) return false;
+        if (!all) floor_used = std::max(floor_used, floor);
+        pend[i] = lk.pending(from[i], end, t0s, sends);
+        needs[i] = lk.need(n, starts[i]);
+        if (needs[i].lo < base) {
+          exact = false;  // its samples have left the window: the bound was broken
+        } else {
+          active.push_back(i);
+        }
+        return true;
+      });
+    };
+    const std::vector<Event>& events = known ? *known : got;
+    if (known) {
+      add_events(*known, 0);
+      settle(*known, 0, true);
     }
-    const long avail = base + static_cast<long>(w.size());
-    while (next < order.size() && needs[order[next]].lo < avail) active.push_back(order[next++]);
-    // The bursts whose window is in: their metrics (each reads w and writes its own Detection
-    // only) on up to jobs_ threads, each with its own PearsonBank; done[i] says which finished.
-    std::vector<std::size_t> ready;
-    for (std::size_t i : active) {
-      if (avail >= needs[i].hi_min) ready.push_back(i);
+    Link::StreamReceiver rcv(lk, scale);
+    BandpassFloat bp(lk.design.filter);  // fixed precision: the metrics' float filter
+    const long reach = static_cast<long>(lk.L) * lk.spc + 3L * lk.spc + 2000;  // need(n, s).lo >= s - reach
+    const long lookback = lookback_ ? *lookback_ : lk.event_lookback();
+    // jobs_ - 1 more matched-filter banks for the worker threads (this thread uses lk.bank)
+    std::vector<std::unique_ptr<PearsonBank>> banks;
+    if (scene_.receiver.metrics.pearson) {
+      for (int t = 1; t < jobs_; ++t) banks.push_back(std::make_unique<PearsonBank>(lk.templates));
     }
-    std::vector<char> done(ready.size(), 0);
-    const std::size_t nt = std::min(static_cast<std::size_t>(std::max(jobs_, 1)), ready.size());
-    parallel_items(ready.size(), nt, [&](std::size_t r, std::size_t t) {
-      // thread 0 uses lk.bank; without Pearson outputs no bank is used and banks is empty
-      PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
-      const auto i = ready[r];
-      done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, pb);
-    });
-    // ready is a subsequence of active, in order: one pass drops the finished ones
-    std::size_t r = 0;
-    std::erase_if(active, [&](std::size_t i) { return r < ready.size() && ready[r] == i && done[r++]; });
-    long keep = next < order.size() ? std::min(avail, needs[order[next]].lo) : avail;
-    for (std::size_t i : active) keep = std::min(keep, needs[i].lo);
-    if (static_cast<std::size_t>(keep - base) >= block && static_cast<std::size_t>(keep - base) * 2 >= w.size()) {
-      w.erase(w.begin(), w.begin() + (keep - base));
-      base = keep;
+    src.rewind();
+    for (bool last = false; !last;) {
+      const std::size_t k = src.read(x);
+      last = k == 0;
+      const long avail = base + static_cast<long>(w.size());
+      std::vector<std::size_t> ready;
+      for (std::size_t i : active) {
+        if (avail >= needs[i].hi_min) ready.push_back(i);
+      }
+      std::vector<char> done(ready.size(), 0);
+      const std::size_t got0 = got.size();
+      // item 0: the receiver on this block (the pending candidate after the last); item 1 at
+      // fixed precision: the float filter; then the ready bursts' metrics
+      const std::size_t first = (metrics && fixed && !last) ? 2 : 1;
+      const std::span<double> xk(x.data(), k);
+      const std::span<double> fk = metrics ? std::span<double>(fnext.data(), k) : std::span<double>();
+      parallel_items(first + ready.size(), std::min<std::size_t>(std::max(jobs_, 1), first + ready.size()),
+                     [&](std::size_t item, std::size_t t) {
+                       if (item == 0) {
+                         if (last) return rcv.finish(got);
+                         if (known && fixed) return;  // the events are known; the filter is item 1
+                         if (on_block && !known) on_block(xk);
+                         return rcv.block(xk, got, fixed ? std::span<double>() : fk);
+                       }
+                       if (item == 1 && first == 2) return bp.execute_block(xk, fk);
+                       const std::size_t r = item - first;
+                       // thread 0 uses lk.bank; without Pearson outputs no bank is used and banks is empty
+                       PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
+                       const auto i = ready[r];
+                       done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, pb);
+                     });
+      // ready is a subsequence of active, in order: one pass drops the finished ones
+      std::size_t r = 0;
+      std::erase_if(active, [&](std::size_t i) { return r < ready.size() && ready[r] == i && done[r++]; });
+      if (metrics) w.insert(w.end(), fk.begin(), fk.end());
+      read += static_cast<long>(k);
+      if (!known) add_events(got, got0);
+      settle(events, read - lookback, last);
+      if (!metrics) continue;
+      // the samples still needed: the pending bursts', and those of events to come
+      long keep = std::min(base + static_cast<long>(w.size()), std::min(read - lookback, n - 1) - reach);
+      for (std::size_t i : active) keep = std::min(keep, needs[i].lo);
+      for (std::size_t i : open) keep = std::min(keep, lk.need(n, starts[i]).lo);
+      if (keep - base >= static_cast<long>(block) && static_cast<std::size_t>(keep - base) * 2 >= w.size()) {
+        w.erase(w.begin(), w.begin() + (keep - base));
+        base = keep;
+      }
     }
-  }
-  if (!active.empty() || next < order.size() || base + static_cast<long>(w.size()) != n) {
-    throw InputError(src.path() + ": changed while it was read");
+    if (!known) ev = std::move(got);
+    if (!metrics) {  // no metric named: the fields set to NaN
+      for (auto& p : pend) (void)lk.metrics_window(p.d, {}, 0, n, p.start, p.end, *lk.bank);
+      result = std::move(pend);
+      return true;
+    }
+    if (!exact) return false;
+    // the last bursts: the whole stream is in the window now
+    std::vector<char> done(active.size(), 0);
+    parallel_items(active.size(), std::min<std::size_t>(std::max(jobs_, 1), active.size()),
+                   [&](std::size_t r, std::size_t t) {
+                     PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
+                     const auto i = active[r];
+                     done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, pb);
+                   });
+    if (read != n || base + static_cast<long>(w.size()) != n || !open.empty() ||
+        std::find(done.begin(), done.end(), 0) != done.end()) {
+      throw InputError(src.path() + ": changed while it was read");
+    }
+    result = std::move(pend);
+    return true;
+  };
+  decode_passes_ = 1;
+  if (!pass(nullptr)) {
+    decode_passes_ = 2;
+    if (!pass(&ev)) throw std::logic_error("decode_stream: the second pass broke its own bound");
   }
   std::vector<Detection> out;
-  for (auto& p : pend) out.push_back(std::move(p.d));
+  for (auto& p : result) out.push_back(std::move(p.d));
   return out;
 }
 

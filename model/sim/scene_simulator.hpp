@@ -152,6 +152,12 @@ class SceneSimulator {
   // results are collected in stream order); a fixed-stream observer forces one thread.
   void set_jobs(int jobs) { jobs_ = jobs; }
   int jobs() const { return jobs_; }
+  // decode_stream's bound on how far behind the receiver an event can start (derived from the
+  // detector's holdoff; nullopt: that). Tests set a bound that events break, to check that the
+  // decode then recomputes the metrics in a second pass and still gives decode()'s detections.
+  void set_event_lookback(std::optional<long> samples) { lookback_ = samples; }
+  // Receiver passes the last decode_stream made: 1, or 2 when an event broke the lookback bound.
+  int decode_passes() const { return decode_passes_; }
 
   // Every measurement of one family (geometry x repeats x bursts). Deterministic for a seed.
   std::vector<Measurement> run(const std::string& family,
@@ -176,13 +182,14 @@ class SceneSimulator {
   std::vector<Detection> decode(const std::string& family, const std::vector<double>& x, double t0,
                                 double period_s = 0);
 
-  // decode() of a capture read in blocks of `block` samples (three passes: its peak, the
-  // receiver, the metrics over a sliding window of the filtered stream): the same detections,
-  // bit for bit, in memory independent of the capture's length (the window spans the bursts
-  // whose metrics are pending, about one burst period). peak: the capture's max |x| when the
-  // caller has it (the first pass is skipped; it must be that maximum); on_block: called with
-  // every block of the capture, in order, as the receiver's pass reads it (a caller's own scan
-  // without a read of its own).
+  // decode() of a capture read in blocks of `block` samples: the same detections, bit for bit,
+  // in memory independent of the capture's length. Two passes: the capture's peak, then the
+  // receiver with the bursts' metrics beside it over a sliding window of the filtered stream
+  // (it spans the bursts whose metrics are pending, about one burst period); jobs() threads
+  // share a block's receiver and metrics. peak: the capture's max |x| when the caller has it
+  // (the first pass is skipped; it must be that maximum); on_block: called with every block of
+  // the capture, in order, as the receiver's pass reads it (a caller's own scan without a read
+  // of its own).
   std::vector<Detection> decode_stream(const std::string& family, CaptureSource& src, double period_s = 0,
                                        std::size_t block = std::size_t{1} << 20, std::optional<double> peak = {},
                                        const std::function<void(std::span<const double>)>& on_block = {});
@@ -216,6 +223,8 @@ class SceneSimulator {
   std::vector<std::unique_ptr<Link>> links_;
   FixedStreamObserver observer_;
   int jobs_ = 1;
+  std::optional<long> lookback_;
+  int decode_passes_ = 0;
   std::uint64_t samples_ = 0;
   StageSeconds stage_s_;
 };
