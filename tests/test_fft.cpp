@@ -92,3 +92,23 @@ TEST(FftSize, IsTheSmallestSevenSmoothNumberAtLeastN) {
   EXPECT_EQ(fft_size(std::size_t{1} << 40), std::size_t{1} << 40);
   EXPECT_THROW(fft_size((std::size_t{1} << 40) + 1), InputError);
 }
+
+// correlation_fft_size: up to 16384 the smallest of 2^a, 3 2^a, 5 2^a >= n (brute force), then
+// fft_size.
+TEST(FftSize, CorrelationSizeIsTheSmallestTwoThreeOrFiveTimesAPowerOfTwo) {
+  auto form = [](std::size_t v) {
+    while (v % 2 == 0) v /= 2;
+    return v == 1 || v == 3 || v == 5;
+  };
+  std::size_t expect = 1;
+  for (std::size_t n = 1; n <= 16384; ++n) {
+    if (expect < n) {
+      expect = n;
+      while (!form(expect)) ++expect;
+    }
+    ASSERT_EQ(correlation_fft_size(n), expect) << n;
+    ASSERT_LE(3 * correlation_fft_size(n), 4 * n + 2) << n;  // at most 4/3 n (n > 2)
+  }
+  EXPECT_EQ(correlation_fft_size(2400), 2560u);  // the decode's Gold Pearson window
+  for (std::size_t n : {16385u, 25000u, 307000u}) EXPECT_EQ(correlation_fft_size(n), fft_size(n)) << n;
+}

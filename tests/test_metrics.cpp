@@ -294,7 +294,7 @@ TEST(PearsonOverLags, TheVectorLoopsGiveTheScalarAlgorithmsBits) {
     const auto got = bank.search(x, lo, hi);
     // the same steps, scalar: centred window, prefix sums, per-lag norms, FFT correlation
     const std::size_t n = ts[0].size(), lags = static_cast<std::size_t>(hi - lo) + 1, w = lags + n - 1;
-    const std::size_t nfft = std::max<std::size_t>(64, fft_size(w)), nc = nfft / 2 + 1;
+    const std::size_t nfft = std::max<std::size_t>(64, correlation_fft_size(w)), nc = nfft / 2 + 1;
     const double* xw = x.data() + lo;
     double mean = 0;
     for (std::size_t i = 0; i < w; ++i) mean += xw[i];

@@ -1,6 +1,7 @@
 #include "model/sim/fft.hpp"
 
 #include <algorithm>
+#include <initializer_list>
 #include <new>
 #include <string>
 
@@ -110,6 +111,18 @@ std::size_t fft_size(std::size_t n) {
         best = std::min(best, v);
       }
     }
+  }
+  return best;
+}
+
+std::size_t correlation_fft_size(std::size_t n) {
+  if (n > 16384) return fft_size(n);
+  std::size_t best = 1;
+  while (best < n) best *= 2;
+  for (std::size_t m : {3, 5}) {
+    std::size_t v = m;
+    while (v < n) v *= 2;
+    best = std::min(best, v);
   }
   return best;
 }

@@ -30,4 +30,10 @@ std::vector<double> convolve(std::span<const double> a, std::span<const double> 
 // cost up to twice as much. n <= 2^40 (InputError beyond).
 std::size_t fft_size(std::size_t n);
 
+// The transform size of a correlation over n points with FFTW_ESTIMATE plans (PearsonBank):
+// n <= 16384: the smallest 2^a, 3 2^a or 5 2^a >= n (at most 4/3 n), whose estimated plans
+// ran 1.1-4.8x faster than those of the fft_size() between them on the machine of
+// docs/results/speed.md; beyond, fft_size(n) (where the powers of two ran slower).
+std::size_t correlation_fft_size(std::size_t n);
+
 }  // namespace ranging

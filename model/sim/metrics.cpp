@@ -220,7 +220,7 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   const std::size_t lags = static_cast<std::size_t>(b - a) + 1;
   const std::size_t w = lags + n_ - 1;  // window x[a, b + N)
   // any size >= w holds the lags' circular correlation without wrap: the next fast size
-  const std::size_t nfft = std::max<std::size_t>(64, fft_size(w));
+  const std::size_t nfft = std::max<std::size_t>(64, correlation_fft_size(w));
   Plan& p = plan(nfft);
   const double* xw = x.data() + a;
   double mean = 0;

@@ -33,7 +33,7 @@ struct LagRho {
 LagRho pearson_over_lags(std::span<const double> x, std::span<const double> t, long lo, long hi);
 
 // The same search for a bank of references of one length at once, by FFT cross-correlation
-// (FFTW, double precision, on fft_size(window) points, model/sim/fft.hpp; agrees with
+// (FFTW, double precision, on correlation_fft_size(window) points, model/sim/fft.hpp; agrees with
 // pearson_over_lags to ~1e-12, tested). Segment sums of x
 // come from prefix sums of x minus the window's mean. A segment whose variance is below 1e-24
 // of the window's largest gives rho 0 there (as pearson() does for zero variance).
