@@ -179,6 +179,31 @@ RANGING_CLONE_V4 double screen_products(const double* o, const double* inv_den, 
   return gmax;
 }
 
+// The indices k < lags with g_k >= lo, in increasing order, into idx; returns how many. Eight
+// lags per compare: a group none of whose lags passes (most) is skipped in one test.
+RANGING_CLONE_V4 std::size_t lags_at_least(const double* g, std::size_t lags, double lo, std::size_t* idx) {
+  typedef double V8 __attribute__((vector_size(64)));
+  typedef std::int64_t I8 __attribute__((vector_size(64)));
+  const V8 lv = V8{} + lo;
+  std::size_t c = 0, k = 0;
+  for (; k + 8 <= lags; k += 8) {
+    V8 a;
+    std::memcpy(&a, g + k, sizeof a);
+    I8 m = a >= lv;  // -1 where it passes
+    m |= __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3);
+    m |= __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
+    m |= __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
+    if (m[0] == 0) continue;
+    for (std::size_t u = k; u < k + 8; ++u) {
+      if (g[u] >= lo) idx[c++] = u;
+    }
+  }
+  for (; k < lags; ++k) {
+    if (g[k] >= lo) idx[c++] = k;
+  }
+  return c;
+}
+
 // prod_i = spec_i ts_i for i < nc, interleaved complex (re, im): (ac - bd) + i(ad + bc), each a
 // product then a sum, never fused. Four products per step.
 RANGING_CLONE_V4 void spectrum_product(const double* spec, const double* ts, double* prod, std::size_t nc) {
@@ -226,17 +251,25 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   double mean = 0;
   for (std::size_t i = 0; i < w; ++i) mean += xw[i];
   mean /= static_cast<double>(w);
-  // Segment sums of (x - mean) and its square by prefix sums.
-  std::vector<double> s1(w + 1, 0.0), s2(w + 1, 0.0);
+  // Segment sums of (x - mean) and its square by prefix sums; x - mean is the transform's input.
+  s1_.resize(w + 1);
+  s2_.resize(w + 1);
+  double* s1 = s1_.data();
+  double* s2 = s2_.data();
+  s1[0] = s2[0] = 0;
   for (std::size_t i = 0; i < w; ++i) {
     const double v = xw[i] - mean;
+    p.in[i] = v;
     s1[i + 1] = s1[i] + v;
     s2[i + 1] = s2[i] + v * v;
   }
-  std::vector<double> den(lags), inv_den(lags), g(lags);
-  lag_norms(s1.data(), s2.data(), n_, lags, den.data(), inv_den.data());
-  std::fill(p.in, p.in + nfft, 0.0);
-  for (std::size_t i = 0; i < w; ++i) p.in[i] = xw[i] - mean;
+  std::fill(p.in + w, p.in + nfft, 0.0);
+  den_.resize(lags);
+  inv_den_.resize(lags);
+  g_.resize(lags);
+  idx_.resize(lags);
+  const double* den = den_.data();
+  lag_norms(s1, s2, n_, lags, den_.data(), inv_den_.data());
   fftw_execute(p.fwd);
   const std::size_t nc = nfft / 2 + 1;
   // 1/nfft (rounded unless nfft is a power of two: rho's rounding stays a few ulps)
@@ -259,12 +292,13 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     // of the plain loop, bit for bit. If the largest rho is itself clamped at -1, every lag is.
     const double* o = p.out;
     const double g1 = tn / inv_nfft;  // g at rho = 1
-    const double gmax = screen_products(o, inv_den.data(), lags, g.data());
+    const double gmax = screen_products(o, inv_den_.data(), lags, g_.data());
     const double lo = (screen_ && tn > 0 && gmax >= -g1 * (1 - 1e-9))
                           ? std::min(gmax, g1 * (1 - 1e-9)) - (std::abs(gmax) + g1) * 1e-12 - 1e-290
                           : -HUGE_VAL;
-    for (std::size_t k = 0; k < lags; ++k) {
-      if (!(g[k] >= lo)) continue;
+    const std::size_t nk = lags_at_least(g_.data(), lags, lo, idx_.data());
+    for (std::size_t c = 0; c < nk; ++c) {
+      const std::size_t k = idx_[c];
       double r = 0;
       if (den[k] > 0 && tn > 0) r = std::clamp(o[k] * inv_nfft / (den[k] * tn), -1.0, 1.0);
       if (r > best.rho) best = {r, a + static_cast<long>(k)};

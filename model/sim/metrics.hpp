@@ -61,6 +61,8 @@ class PearsonBank {
   std::vector<std::vector<double>> t_;  // centred templates
   std::vector<double> tnorm_;           // sqrt(sum tc^2)
   std::map<std::size_t, std::unique_ptr<Plan>> plans_;
+  std::vector<double> s1_, s2_, den_, inv_den_, g_;  // search()'s per-window scratch
+  std::vector<std::size_t> idx_;
 };
 
 // Eq. 10 for one received signal: u = rho(code sent) - max over the other codes j of rho_j,
