@@ -1177,7 +1177,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     std::vector<std::size_t> open, active;  // end unknown yet / metrics pending
     long floor_used = std::numeric_limits<long>::min();  // the largest bound a burst relied on
     bool exact = true;
-    std::vector<double> w, fnext(metrics ? block : 0);  // w = f[base, base + w.size())
+    std::vector<double> w;  // w = f[base, base + w.size())
     long base = 0, read = 0;
     auto add_events = [&](const std::vector<Event>& from, std::size_t i0) {
       for (std::size_t i = i0; i < from.size(); ++i) {
@@ -1221,42 +1221,55 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     if (scene_.receiver.metrics.pearson) {
       for (int t = 1; t < jobs_; ++t) banks.push_back(std::make_unique<PearsonBank>(lk.templates));
     }
+    // Blocks are read one ahead (item 1 of a round reads the next while item 0 receives this one).
+    std::vector<double> xn(block);
     src.rewind();
+    std::size_t k = src.read(x);
     for (bool last = false; !last;) {
-      const std::size_t k = src.read(x);
       last = k == 0;
-      const long avail = base + static_cast<long>(w.size());
+      const std::size_t w0 = w.size();
+      const long avail = base + static_cast<long>(w0);
       std::vector<std::size_t> ready;
       for (std::size_t i : active) {
         if (avail >= needs[i].hi_min) ready.push_back(i);
       }
       std::vector<char> done(ready.size(), 0);
       const std::size_t got0 = got.size();
-      // item 0: the receiver on this block (the pending candidate after the last); item 1 at
-      // fixed precision: the float filter; then the ready bursts' metrics
-      const std::size_t first = (metrics && fixed && !last) ? 2 : 1;
+      // the block's filtered samples go to the window's end; the metrics read what was there
+      if (metrics) w.resize(w0 + k);
+      const std::span<const double> wr(w.data(), w0);
+      const std::span<double> fk = metrics ? std::span<double>(w.data() + w0, k) : std::span<double>();
       const std::span<double> xk(x.data(), k);
-      const std::span<double> fk = metrics ? std::span<double>(fnext.data(), k) : std::span<double>();
+      std::size_t k_next = 0;
+      // item 0: the receiver on this block (the pending candidate after the last); item 1: the
+      // next block's read; item 2 at fixed precision: the metrics' float filter; then the ready
+      // bursts' metrics
+      const std::size_t first = last ? 1 : (metrics && fixed) ? 3 : 2;
       parallel_items(first + ready.size(), std::min<std::size_t>(std::max(jobs_, 1), first + ready.size()),
                      [&](std::size_t item, std::size_t t) {
                        if (item == 0) {
                          if (last) return rcv.finish(got);
-                         if (known && fixed) return;  // the events are known; the filter is item 1
+                         if (known && fixed) return;  // the events are known; the filter is item 2
                          if (on_block && !known) on_block(xk);
                          return rcv.block(xk, got, fixed ? std::span<double>() : fk);
                        }
-                       if (item == 1 && first == 2) return bp.execute_block(xk, fk);
+                       if (item == 1 && !last) {
+                         k_next = src.read(xn);
+                         return;
+                       }
+                       if (item == 2 && first == 3) return bp.execute_block(xk, fk);
                        const std::size_t r = item - first;
                        // thread 0 uses lk.bank; without Pearson outputs no bank is used and banks is empty
                        PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
                        const auto i = ready[r];
-                       done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, pb);
+                       done[r] = lk.metrics_window(pend[i].d, wr, base, n, pend[i].start, pend[i].end, pb);
                      });
+      x.swap(xn);
       // ready is a subsequence of active, in order: one pass drops the finished ones
       std::size_t r = 0;
       std::erase_if(active, [&](std::size_t i) { return r < ready.size() && ready[r] == i && done[r++]; });
-      if (metrics) w.insert(w.end(), fk.begin(), fk.end());
       read += static_cast<long>(k);
+      k = k_next;
       if (!known) add_events(got, got0);
       settle(events, read - lookback, last);
       if (!metrics) continue;
