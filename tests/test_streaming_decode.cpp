@@ -200,6 +200,25 @@ TEST(StreamingDecode, Pcm16WavAndCsvEqualWholeFile) {
   }
 }
 
+// The scan handed to the constructor (decode's peak) sees every sample once, in order, as
+// read() gives it: in the validation pass (CSV, float WAV) or an extra read (PCM WAV).
+TEST(StreamingDecode, TheOpenScanSeesTheSamplesReadGives) {
+  Capture c = capture();
+  c.samples.resize(9000);  // a few of the CSV's 4096-row scan blocks
+  for (const char* name : {"scan.csv", "scan16.wav", "scan32f.wav", "scan64f.wav"}) {
+    const std::string n = name;
+    const std::string bytes = n.ends_with(".csv")  ? capture_csv(c)
+                              : n == "scan16.wav" ? capture_wav(c, WavFormat::Pcm16, 0.5)
+                              : n == "scan32f.wav" ? capture_wav(c, WavFormat::Float32)
+                                                   : capture_wav(c, WavFormat::Float64);
+    const std::string p = write(name, bytes);
+    std::vector<double> seen;
+    CaptureSource src(p, {}, [&](std::span<const double> x) { seen.insert(seen.end(), x.begin(), x.end()); });
+    EXPECT_EQ(seen, read_capture(p).samples) << name;
+    EXPECT_EQ(seen.size(), src.size()) << name;
+  }
+}
+
 TEST(StreamingDecode, SamplesAndMetadataAsReadCapture) {
   for (const char* name : {"meta.wav", "meta.csv"}) {
     Capture c = capture();

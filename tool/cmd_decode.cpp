@@ -123,7 +123,12 @@ int cmd_decode(const Args& args) {
   const int channel = static_cast<int>(p.integer("--channel", 1, 1, 65535));
   const CaptureRead how{channel, p.has("--sample-rate") ? p.number("--sample-rate", 0, 1e4, 1e9) : 0.0};
   // Streamed (model/sim/capture_stream.hpp): validated whole at open, then read in blocks.
-  CaptureSource cap(path, how);
+  // Input clipping: the capture's flat tops at its extreme values (model/sim/metrics.hpp), in
+  // two streamed passes: the extremes (whose larger magnitude is the decode's peak, so the
+  // decode skips its own peak pass), seen as the capture is opened, then the runs at them,
+  // during the receiver's pass.
+  FlatTopScan scan;
+  CaptureSource cap(path, how, [&](std::span<const double> x) { scan.levels(x); });
   std::string rate_note;  // where the sample rate came from, when an option set it
   if (how.sample_rate > 0) {
     std::ostringstream os;
@@ -246,15 +251,6 @@ int cmd_decode(const Args& args) {
     cal = calibrate_latency(kd, cal_distance, c.value, "option --calibrate (" + cal_path + ")");
   }
 
-  // Input clipping: the capture's flat tops at its extreme values (model/sim/metrics.hpp), in
-  // two streamed passes: the extremes (whose larger magnitude is the decode's peak, so the
-  // decode skips its own peak pass), then the runs at them, during the receiver's pass.
-  FlatTopScan scan;
-  {
-    std::vector<double> buf(std::min<std::size_t>(block, std::max<std::size_t>(cap.size(), 1)));
-    cap.rewind();
-    for (std::size_t k; (k = cap.read(buf)) > 0;) scan.levels(std::span<const double>(buf.data(), k));
-  }
   const FlatTops levels = scan.result();
   const double peak = std::max(std::abs(levels.high), std::abs(levels.low));
   std::vector<Detection> dets, below;

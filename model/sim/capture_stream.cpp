@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <vector>
 
 #include "model/base/error.hpp"
 #include "model/base/input_file.hpp"
@@ -15,7 +16,10 @@ namespace {
 constexpr std::size_t kWavBlockBytes = std::size_t{1} << 20;
 }
 
-CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how) : path_(path) {
+CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how,
+                             const std::function<void(std::span<const double>)>& scan)
+    : path_(path) {
+  std::vector<double> block;  // scan's samples
   std::string ext;
   if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
@@ -33,28 +37,36 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how) : 
   if (!in_) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
   const std::size_t file_size = static_cast<std::size_t>(fs::file_size(path, ec));
   if (csv_) {
-    CsvCaptureScan scan(path, how);
+    CsvCaptureScan rows(path, how);
     std::string line;
     double t = 0, v = 0;
-    while (std::getline(in_, line)) (void)scan.line(line, t, v);
+    while (std::getline(in_, line)) {
+      if (!rows.line(line, t, v) || !scan) continue;
+      block.push_back(v);
+      if (block.size() == 4096) {
+        scan(block);
+        block.clear();
+      }
+    }
     if (in_.bad()) throw InputError(path + ": cannot read the capture file");
-    scan.finish();
+    rows.finish();
+    if (scan && !block.empty()) scan(block);
     // Second pass: every row on the uniform grid (the rows are known to be well formed now).
     in_.clear();
     in_.seekg(0);
     CsvCaptureScan again(path, how);
     std::size_t n = 0;
     while (std::getline(in_, line)) {
-      if (again.line(line, t, v)) scan.check_grid(n++, t, again.lineno());
+      if (again.line(line, t, v)) rows.check_grid(n++, t, again.lineno());
     }
-    rate_ = scan.sample_rate();
-    t0_ = scan.t0();
-    n_ = scan.rows();
-    meta_ = scan.meta();
-    first_data_line_ = scan.first_data_line();
-    channels_ = scan.channels();
-    cell_ = scan.value_cell();
-    file_rate_ = scan.has_time() ? rate_ : 0;
+    rate_ = rows.sample_rate();
+    t0_ = rows.t0();
+    n_ = rows.rows();
+    meta_ = rows.meta();
+    first_data_line_ = rows.first_data_line();
+    channels_ = rows.channels();
+    cell_ = rows.value_cell();
+    file_rate_ = rows.has_time() ? rate_ : 0;
   } else {
     wav_ = parse_wav_layout(
         [&](std::size_t at, std::size_t len) {
@@ -70,10 +82,11 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how) : 
     file_rate_ = wav_.rate;
     rate_ = how.sample_rate > 0 ? how.sample_rate : wav_.rate;
     n_ = wav_.n;
-    if (wav_.flt || n_ < 2) {  // NaN/Inf are refused before anything is decoded (read_capture's order)
+    if (wav_.flt || n_ < 2 || scan) {  // NaN/Inf are refused before anything is decoded (read_capture's order)
       rewind();
-      std::vector<double> block(4096);
-      while (read(block) > 0) {
+      block.resize(std::size_t{1} << 16);
+      for (std::size_t k; (k = read(block)) > 0;) {
+        if (scan) scan(std::span<const double>(block.data(), k));
       }
     }
     if (n_ < 2) throw InputError(path + ": byte " + std::to_string(wav_.chunk_at) + ": the data chunk holds fewer than two samples");

@@ -87,8 +87,12 @@ void merge_capture_sidecar(CaptureMeta& meta, const std::string& path);
 
 class CaptureSource {
  public:
-  // Validates the whole file (InputError); how: as read_capture.
-  explicit CaptureSource(const std::string& path, const CaptureRead& how = {});
+  // Validates the whole file (InputError); how: as read_capture. scan, when given, sees every
+  // sample once, in order, in blocks, before the constructor returns: in the validation pass
+  // for the files open reads whole anyway (CSV, float WAV), else in one read at its end (a
+  // caller's whole-capture scan, such as decode's peak, without a pass of its own).
+  explicit CaptureSource(const std::string& path, const CaptureRead& how = {},
+                         const std::function<void(std::span<const double>)>& scan = {});
   ~CaptureSource();
   int channels() const { return channels_; }  // how many the file has
   double file_rate() const { return file_rate_; }  // the rate the file states (0: none)
