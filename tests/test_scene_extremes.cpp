@@ -310,6 +310,34 @@ TEST(FlatTopClipping, BlocksOfAnySizeCountThePlainRuns) {
   }
 }
 
+// levels() (eight lanes at a time) finds std::minmax_element's values: the extremes at every
+// position of a block of every length, and a zero extreme with std::minmax_element's sign
+// (the first smallest, the last largest).
+TEST(FlatTopClipping, LevelsAreMinmaxElementsValues) {
+  std::mt19937_64 rng(11);
+  for (std::size_t n = 1; n <= 40; ++n) {
+    for (std::size_t at = 0; at < n; ++at) {
+      std::vector<double> x(n);
+      for (double& v : x) v = std::uniform_real_distribution<double>(-1, 1)(rng);
+      x[at] = 3.0;
+      x[n - 1 - at] = -2.0;
+      FlatTopScan scan;
+      scan.levels(x);
+      const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+      ASSERT_EQ(scan.result().high, *hi) << n << " " << at;
+      ASSERT_EQ(scan.result().low, *lo) << n << " " << at;
+    }
+  }
+  for (const std::vector<double>& x : {std::vector<double>{-1, 0.0, -0.0}, std::vector<double>{-0.0, 0.0, 1, 2, 3, 4, 5, 6, 7, 8},
+                                       std::vector<double>(17, -0.0)}) {
+    FlatTopScan scan;
+    scan.levels(x);
+    const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+    EXPECT_EQ(std::signbit(scan.result().high), std::signbit(*hi));
+    EXPECT_EQ(std::signbit(scan.result().low), std::signbit(*lo));
+  }
+}
+
 // The tools never clip silently: simulate's text and JSON summaries and decode's output name it,
 // and a range-ambiguous scene warns on stderr and never reads "errors 0".
 TEST(SceneExtremesCli, SimulateAndDecodeReportClipping) {

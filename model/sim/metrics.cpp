@@ -506,11 +506,60 @@ int eta_required(double max_distance_m, double period_s, double c) {
   return std::max(1, static_cast<int>(eta));
 }
 
+namespace {
+// The largest and smallest of x (n >= 1) eight lanes at a time; false (lo, hi unset) when x
+// holds a NaN or the result is a zero (whose sign then depends on the order: the caller takes
+// std::minmax_element's then).
+RANGING_CLONE_V4 bool extremes(const double* x, std::size_t n, double& lo, double& hi) {
+  typedef double V8 __attribute__((vector_size(64)));
+  V8 mx = V8{} + x[0], mn = mx, nan = V8{};
+  std::size_t k = 0;
+  for (; k + 8 <= n; k += 8) {
+    V8 a;
+    std::memcpy(&a, x + k, sizeof a);
+    mx = a > mx ? a : mx;
+    mn = a < mn ? a : mn;
+    nan += a - a;  // NaN stays
+  }
+  double h = mx[0], l = mn[0], bad = 0;
+  for (int u = 0; u < 8; ++u) h = std::max(h, mx[u]), l = std::min(l, mn[u]), bad += nan[u];
+  for (; k < n; ++k) h = std::max(h, x[k]), l = std::min(l, x[k]), bad += x[k] - x[k];
+  if (bad != 0 || h == 0 || l == 0) return false;
+  lo = l, hi = h;
+  return true;
+}
+
+// The first index i with x[i] == a or x[i] == b, else n; eight lanes per compare.
+RANGING_CLONE_V4 std::size_t find_either(const double* x, std::size_t n, double a, double b) {
+  typedef double V8 __attribute__((vector_size(64)));
+  typedef std::int64_t I8 __attribute__((vector_size(64)));
+  const V8 av = V8{} + a, bv = V8{} + b;
+  std::size_t k = 0;
+  for (; k + 8 <= n; k += 8) {
+    V8 v;
+    std::memcpy(&v, x + k, sizeof v);
+    I8 m = (v == av) | (v == bv);
+    m |= __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3);
+    m |= __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
+    m |= __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
+    if (m[0] != 0) break;
+  }
+  for (; k < n; ++k) {
+    if (x[k] == a || x[k] == b) return k;
+  }
+  return n;
+}
+}  // namespace
+
 void FlatTopScan::levels(std::span<const double> x) {
   if (x.empty()) return;
-  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
-  t_.high = any_ ? std::max(t_.high, *hi) : *hi;
-  t_.low = any_ ? std::min(t_.low, *lo) : *lo;
+  double lo = 0, hi = 0;
+  if (!extremes(x.data(), x.size(), lo, hi)) {
+    const auto [l, h] = std::minmax_element(x.begin(), x.end());
+    lo = *l, hi = *h;
+  }
+  t_.high = any_ ? std::max(t_.high, hi) : hi;
+  t_.low = any_ ? std::min(t_.low, lo) : lo;
   any_ = true;
 }
 
@@ -531,7 +580,7 @@ void FlatTopScan::runs(std::span<const double> x) {
   // the runs in progress, the others find them closed (run 0 < min_run). So one such step
   // stands for all of them, and most blocks (no flat top) cost one search.
   const double hi = t_.high, lo = t_.low;
-  const auto first = std::find_if(x.begin(), x.end(), [&](double v) { return v == hi || v == lo; });
+  const auto first = x.begin() + static_cast<std::ptrdiff_t>(find_either(x.data(), x.size(), hi, lo));
   if (first != x.begin()) {
     step(run_high_, false);
     if (hi != lo) step(run_low_, false);
