@@ -48,20 +48,16 @@ LagRho pearson_over_lags(std::span<const double> x, std::span<const double> t, l
 // of different threads (sweep --jobs, SceneSimulator::set_jobs) coexist.
 struct PearsonBank::Plan {
   std::size_t nfft = 0;
-  double* in = nullptr;
-  fftw_complex* spec = nullptr;
-  fftw_complex* prod = nullptr;
-  double* out = nullptr;
+  // The transforms' arrays, 64-byte aligned (fftw_alloc gives 32: an AVX-512 loop over them
+  // would then split every load across two cache lines; FFTW plans the same for either).
+  AlignedVector<double> in, out;
+  AlignedVector<std::complex<double>> spec, prod;
   fftw_plan fwd = nullptr, inv = nullptr;
-  std::vector<std::vector<std::complex<double>>> tspec;  // conj FFT of each centred template
+  std::vector<AlignedVector<std::complex<double>>> tspec;  // conj FFT of each centred template
   ~Plan() {
     const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
     if (fwd) fftw_destroy_plan(fwd);
     if (inv) fftw_destroy_plan(inv);
-    fftw_free(in);
-    fftw_free(spec);
-    fftw_free(prod);
-    fftw_free(out);
   }
 };
 
@@ -94,23 +90,25 @@ PearsonBank::Plan& PearsonBank::plan(std::size_t nfft) {
   auto p = std::make_unique<Plan>();
   p->nfft = nfft;
   const std::size_t nc = nfft / 2 + 1;
-  p->in = fftw_alloc_real(nfft);
-  p->out = fftw_alloc_real(nfft);
-  p->spec = fftw_alloc_complex(nc);
-  p->prod = fftw_alloc_complex(nc);
-  if (!p->in || !p->out || !p->spec || !p->prod) throw std::bad_alloc();
+  p->in.assign(nfft, 0.0);
+  p->out.assign(nfft, 0.0);
+  p->spec.assign(nc, 0.0);
+  p->prod.assign(nc, 0.0);
+  auto* spec = reinterpret_cast<fftw_complex*>(p->spec.data());
+  auto* prod = reinterpret_cast<fftw_complex*>(p->prod.data());
   const int n = static_cast<int>(nfft);
   {
     const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-    p->fwd = fftw_plan_dft_r2c_1d(n, p->in, p->spec, FFTW_ESTIMATE);
-    p->inv = fftw_plan_dft_c2r_1d(n, p->prod, p->out, FFTW_ESTIMATE);
+    p->fwd = fftw_plan_dft_r2c_1d(n, p->in.data(), spec, FFTW_ESTIMATE);
+    p->inv = fftw_plan_dft_c2r_1d(n, prod, p->out.data(), FFTW_ESTIMATE);
   }
+  if (!p->fwd || !p->inv) throw std::bad_alloc();
   for (const auto& t : t_) {
-    std::fill(p->in, p->in + nfft, 0.0);
-    std::copy(t.begin(), t.end(), p->in);
+    std::fill(p->in.begin(), p->in.end(), 0.0);
+    std::copy(t.begin(), t.end(), p->in.begin());
     fftw_execute(p->fwd);
-    std::vector<std::complex<double>> c(nc);
-    for (std::size_t i = 0; i < nc; ++i) c[i] = std::conj(std::complex<double>(p->spec[i][0], p->spec[i][1]));
+    AlignedVector<std::complex<double>> c(nc);
+    for (std::size_t i = 0; i < nc; ++i) c[i] = std::conj(p->spec[i]);
     p->tspec.push_back(std::move(c));
   }
   return *plans_.emplace(nfft, std::move(p)).first->second;
@@ -263,7 +261,7 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     s1[i + 1] = s1[i] + v;
     s2[i + 1] = s2[i] + v * v;
   }
-  std::fill(p.in + w, p.in + nfft, 0.0);
+  std::fill(p.in.begin() + static_cast<std::ptrdiff_t>(w), p.in.end(), 0.0);
   den_.resize(lags);
   inv_den_.resize(lags);
   g_.resize(lags);
@@ -279,7 +277,8 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     // The spectrum product written out: (a + ib)(c + id) = (ac - bd) + i(ad + bc), the
     // expressions std::complex's multiplication computes for finite operands, without its
     // NaN recovery branch (both spectra are finite: FFTs of finite data).
-    spectrum_product(&p.spec[0][0], reinterpret_cast<const double*>(p.tspec[j].data()), &p.prod[0][0], nc);
+    spectrum_product(reinterpret_cast<const double*>(p.spec.data()), reinterpret_cast<const double*>(p.tspec[j].data()),
+                     reinterpret_cast<double*>(p.prod.data()), nc);
     fftw_execute(p.inv);  // unnormalized: out = nfft * correlation
     LagRho best{-2.0, a};
     const double tn = tnorm_[j];
@@ -290,7 +289,7 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     // only for the lags that can be the first maximum: g_k within 1e-12 (relative) of the
     // largest g, or (when rho reaches the clamp at 1) of g at rho = 1. So the result is the one
     // of the plain loop, bit for bit. If the largest rho is itself clamped at -1, every lag is.
-    const double* o = p.out;
+    const double* o = p.out.data();
     const double g1 = tn / inv_nfft;  // g at rho = 1
     const double gmax = screen_products(o, inv_den_.data(), lags, g_.data());
     const double lo = (screen_ && tn > 0 && gmax >= -g1 * (1 - 1e-9))

@@ -11,6 +11,8 @@
 #include <span>
 #include <vector>
 
+#include "model/base/aligned.hpp"
+
 namespace ranging {
 
 // Eq. 9 (and 8): Pearson correlation coefficient of two equal-length signals.
@@ -61,7 +63,7 @@ class PearsonBank {
   std::vector<std::vector<double>> t_;  // centred templates
   std::vector<double> tnorm_;           // sqrt(sum tc^2)
   std::map<std::size_t, std::unique_ptr<Plan>> plans_;
-  std::vector<double> s1_, s2_, den_, inv_den_, g_;  // search()'s per-window scratch
+  AlignedVector<double> s1_, s2_, den_, inv_den_, g_;  // search()'s per-window scratch
   std::vector<std::size_t> idx_;
 };
 
