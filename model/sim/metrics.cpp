@@ -575,18 +575,22 @@ void FlatTopScan::runs(std::span<const double> x) {
     }
     run = 0;
   };
-  // Up to the first sample at either level every step is a "not at level": the first closes
-  // the runs in progress, the others find them closed (run 0 < min_run). So one such step
-  // stands for all of them, and most blocks (no flat top) cost one search.
+  // Between samples at either level every step is a "not at level": the first closes the runs
+  // in progress, the others find them closed (run 0 < min_run >= 1). So one such step stands
+  // for all of them: a search jumps to the next sample at a level, and most blocks (no flat
+  // top) cost one search.
   const double hi = t_.high, lo = t_.low;
-  const auto first = x.begin() + static_cast<std::ptrdiff_t>(find_either(x.data(), x.size(), hi, lo));
-  if (first != x.begin()) {
-    step(run_high_, false);
-    if (hi != lo) step(run_low_, false);
-  }
-  for (auto it = first; it != x.end(); ++it) {
-    step(run_high_, *it == hi);
-    if (hi != lo) step(run_low_, *it == lo);
+  const std::size_t n = x.size();
+  for (std::size_t i = 0; i < n;) {
+    const std::size_t j = i + find_either(x.data() + i, n - i, hi, lo);
+    if (j != i) {
+      step(run_high_, false);
+      if (hi != lo) step(run_low_, false);
+    }
+    for (i = j; i < n && (x[i] == hi || x[i] == lo); ++i) {
+      step(run_high_, x[i] == hi);
+      if (hi != lo) step(run_low_, x[i] == lo);
+    }
   }
 }
 
