@@ -279,7 +279,7 @@ TEST(PearsonOverLags, ScreeningTheLagsGivesThePlainLoopsResultBitForBit) {
   EXPECT_EQ(screened.search(xs[1], 7, 300)[0].lag, 7);
 }
 
-// The search's loops (lag norms, spectrum product, screening) run in AVX-512 clones on a CPU
+// The search's loops (centred sums, lag norms, spectrum product, screening) run in AVX-512 clones on a CPU
 // that has them (metrics.cpp). Its results must be, bit for bit, this plain scalar computation
 // of the same algorithm (this file is built for the baseline ISA without contraction): a clone
 // that fused a product into a sum, or reordered a sum, fails it.
@@ -296,15 +296,28 @@ TEST(PearsonOverLags, TheVectorLoopsGiveTheScalarAlgorithmsBits) {
     const std::size_t n = ts[0].size(), lags = static_cast<std::size_t>(hi - lo) + 1, w = lags + n - 1;
     const std::size_t nfft = std::max<std::size_t>(64, correlation_fft_size(w)), nc = nfft / 2 + 1;
     const double* xw = x.data() + lo;
+    // the mean in eight lanes (lane u: the samples i = u mod 8), then the lanes in order
+    double lane[8] = {};
+    for (std::size_t i = 0; i < w; ++i) lane[i % 8] += xw[i];
     double mean = 0;
-    for (std::size_t i = 0; i < w; ++i) mean += xw[i];
+    for (double v : lane) mean += v;
     mean /= static_cast<double>(w);
+    // prefix sums in eight chunks of ceil(w / 8) samples, then each chunk plus the ones before
     std::vector<double> s1(w + 1, 0.0), s2(w + 1, 0.0), den(lags), in(nfft, 0.0), out(nfft);
-    for (std::size_t i = 0; i < w; ++i) {
-      const double v = xw[i] - mean;
-      s1[i + 1] = s1[i] + v;
-      s2[i + 1] = s2[i] + v * v;
-      in[i] = v;
+    const std::size_t len = (w + 7) / 8;
+    double o1 = 0, o2 = 0;
+    for (std::size_t c = 0; c * len < w; ++c) {
+      double a1 = 0, a2 = 0;
+      for (std::size_t i = c * len; i < std::min(w, (c + 1) * len); ++i) {
+        const double v = xw[i] - mean;
+        a1 += v;
+        a2 += v * v;
+        s1[i + 1] = c == 0 ? a1 : a1 + o1;
+        s2[i + 1] = c == 0 ? a2 : a2 + o2;
+        in[i] = v;
+      }
+      o1 += a1;
+      o2 += a2;
     }
     double den_max = 0;
     for (std::size_t k = 0; k < lags; ++k) {

@@ -122,6 +122,50 @@ namespace {
 #define RANGING_CLONE_V4
 #endif
 
+// The centred window's sums, in eight independent chains (a single running sum is one add per
+// four cycles; eight keep the adder busy), every operation in a fixed order, so the AVX-512
+// clone and the baseline give the same bits:
+//   mean = (sum over lanes u = 0..7 in order of S_u) / w, S_u = sum of x[i], i = u mod 8, i ascending;
+//   v_i = x_i - mean into in[i]; s1, s2 (w + 1 entries, s[0] = 0): the prefix sums of v and v^2
+//   in eight chunks of ceil(w / 8) consecutive samples, each summed from its start, then each
+//   chunk's entries plus the sum of the chunks before it (added chunk by chunk, in order).
+RANGING_CLONE_V4 void centred_sums(const double* x, std::size_t w, double* in, double* s1, double* s2) {
+  double lane[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  std::size_t i = 0;
+  for (; i + 8 <= w; i += 8) {
+    for (std::size_t u = 0; u < 8; ++u) lane[u] += x[i + u];
+  }
+  for (std::size_t u = 0; i < w; ++i, ++u) lane[u] += x[i];
+  double total = 0;
+  for (double v : lane) total += v;
+  const double mean = total / static_cast<double>(w);
+  const std::size_t len = (w + 7) / 8;
+  double a1[8] = {0, 0, 0, 0, 0, 0, 0, 0}, a2[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  s1[0] = s2[0] = 0;
+  for (std::size_t j = 0; j < len; ++j) {
+    for (std::size_t c = 0; c < 8; ++c) {
+      const std::size_t k = c * len + j;
+      if (k >= w) continue;
+      const double v = x[k] - mean;
+      in[k] = v;
+      a1[c] += v;
+      a2[c] += v * v;
+      s1[k + 1] = a1[c];
+      s2[k + 1] = a2[c];
+    }
+  }
+  double o1 = 0, o2 = 0;
+  for (std::size_t c = 1; c < 8 && c * len < w; ++c) {
+    o1 += a1[c - 1];
+    o2 += a2[c - 1];
+    const std::size_t end = std::min(w, (c + 1) * len);
+    for (std::size_t k = c * len; k < end; ++k) {
+      s1[k + 1] += o1;
+      s2[k + 1] += o2;
+    }
+  }
+}
+
 // Per lag k < lags of the window (prefix sums s1, s2 of x - mean): var_k = max(0, S2 - S1^2 / N)
 // over x[k, k + N); then den_k = sqrt(var_k), 0 where the window is flat (var_k <= 1e-24 of the
 // largest, or 0: rho = 0 there), inv_den_k = 1 / den_k (0 there). Every lag on its own, IEEE
@@ -246,21 +290,12 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   const std::size_t nfft = std::max<std::size_t>(64, correlation_fft_size(w));
   Plan& p = plan(nfft);
   const double* xw = x.data() + a;
-  double mean = 0;
-  for (std::size_t i = 0; i < w; ++i) mean += xw[i];
-  mean /= static_cast<double>(w);
   // Segment sums of (x - mean) and its square by prefix sums; x - mean is the transform's input.
   s1_.resize(w + 1);
   s2_.resize(w + 1);
-  double* s1 = s1_.data();
-  double* s2 = s2_.data();
-  s1[0] = s2[0] = 0;
-  for (std::size_t i = 0; i < w; ++i) {
-    const double v = xw[i] - mean;
-    p.in[i] = v;
-    s1[i + 1] = s1[i] + v;
-    s2[i + 1] = s2[i] + v * v;
-  }
+  const double* s1 = s1_.data();
+  const double* s2 = s2_.data();
+  centred_sums(xw, w, p.in.data(), s1_.data(), s2_.data());
   std::fill(p.in.begin() + static_cast<std::ptrdiff_t>(w), p.in.end(), 0.0);
   den_.resize(lags);
   inv_den_.resize(lags);
