@@ -225,17 +225,19 @@ RANGING_CLONE_V4 double screen_products(const double* o, const double* inv_den, 
 // lags per compare: a group none of whose lags passes (most) is skipped in one test.
 RANGING_CLONE_V4 std::size_t lags_at_least(const double* g, std::size_t lags, double lo, std::size_t* idx) {
   typedef double V8 __attribute__((vector_size(64)));
-  typedef std::int64_t I8 __attribute__((vector_size(64)));
-  const V8 lv = V8{} + lo;
   std::size_t c = 0, k = 0;
   for (; k + 8 <= lags; k += 8) {
     V8 a;
     std::memcpy(&a, g + k, sizeof a);
-    I8 m = a >= lv;  // -1 where it passes
-    m |= __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3);
-    m |= __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
-    m |= __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
-    if (m[0] == 0) continue;
+    // the group's largest (max blends and whole-vector shuffles: GCC 12 turns a vector of
+    // comparison masks into scalar code, a blend it keeps in the vector unit)
+    V8 m = __builtin_shufflevector(a, a, 4, 5, 6, 7, 0, 1, 2, 3);
+    m = a > m ? a : m;
+    V8 t = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
+    m = m > t ? m : t;
+    t = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
+    m = m > t ? m : t;
+    if (!(m[0] >= lo)) continue;
     for (std::size_t u = k; u < k + 8; ++u) {
       if (g[u] >= lo) idx[c++] = u;
     }
@@ -563,20 +565,27 @@ RANGING_CLONE_V4 bool extremes(const double* x, std::size_t n, double& lo, doubl
   return true;
 }
 
-// The first index i with x[i] == a or x[i] == b, else n; eight lanes per compare.
+// The first index i with x[i] == a or x[i] == b, else n (x, a, b finite: x - a is 0 exactly
+// when x == a). Eight lanes per step: the group's smallest min(|x - a|, |x - b|), by blends and
+// whole-vector shuffles, is tested against 0.
 RANGING_CLONE_V4 std::size_t find_either(const double* x, std::size_t n, double a, double b) {
   typedef double V8 __attribute__((vector_size(64)));
-  typedef std::int64_t I8 __attribute__((vector_size(64)));
-  const V8 av = V8{} + a, bv = V8{} + b;
+  const V8 av = V8{} + a, bv = V8{} + b, zero = V8{};
   std::size_t k = 0;
   for (; k + 8 <= n; k += 8) {
     V8 v;
     std::memcpy(&v, x + k, sizeof v);
-    I8 m = (v == av) | (v == bv);
-    m |= __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3);
-    m |= __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
-    m |= __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
-    if (m[0] != 0) break;
+    V8 da = v - av, db = v - bv;
+    da = da < zero ? zero - da : da;
+    db = db < zero ? zero - db : db;
+    V8 m = da < db ? da : db;
+    V8 t = __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3);
+    m = m < t ? m : t;
+    t = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
+    m = m < t ? m : t;
+    t = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
+    m = m < t ? m : t;
+    if (m[0] == 0) break;
   }
   for (; k < n; ++k) {
     if (x[k] == a || x[k] == b) return k;
