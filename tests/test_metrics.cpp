@@ -462,6 +462,41 @@ TEST(DurationStream, MeasuresUntilTheSignalEndsAndFlagsClipping) {
   EXPECT_THROW(duration_td_stream(std::vector<double>(100, 0.0), 0, 100, 0, 100, 10, fs), InputError);
 }
 
+// kth_smallest (T_d's noise median) gives std::nth_element's value for every k of arrays that
+// take its bracketed pass (n >= 512) and its fallback: noise, many ties, sorted and reversed,
+// all equal, zeros of both signs, and a sample that misses the rank (the sampled positions
+// all hold the largest values).
+TEST(KthSmallest, IsNthElementsValue) {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> noise(0, 1);
+  auto check = [&](std::vector<double> v, const char* what) {
+    std::vector<double> buf(v.size());
+    for (std::size_t k : {std::size_t{0}, v.size() / 4, v.size() / 2, v.size() - 1, (v.size() * 7) / 9}) {
+      std::vector<double> a = v, b = v;
+      std::nth_element(a.begin(), a.begin() + static_cast<long>(k), a.end());
+      const double got = kth_smallest(b.data(), b.size(), k, buf.data());
+      ASSERT_EQ(got, a[k]) << what << " n " << v.size() << " k " << k;
+    }
+  };
+  for (std::size_t n : {1u, 2u, 100u, 511u, 512u, 513u, 1999u, 2000u, 3001u}) {
+    std::vector<double> v(n);
+    for (double& x : v) x = std::abs(noise(rng));
+    check(v, "noise");
+    for (double& x : v) x = std::floor(4 * std::abs(noise(rng)));
+    check(v, "ties");
+    std::sort(v.begin(), v.end());
+    check(v, "sorted");
+    std::reverse(v.begin(), v.end());
+    check(v, "reversed");
+    check(std::vector<double>(n, 0.25), "equal");
+    for (std::size_t i = 0; i < n; ++i) v[i] = i % 2 ? 0.0 : -0.0;
+    check(v, "zeros");
+    for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<double>(i);
+    for (std::size_t i = 0; i < 128 && n >= 512; ++i) v[i * n / 128] = 1e9 + static_cast<double>(i);
+    check(v, "missed bracket");
+  }
+}
+
 TEST(Spearman, RanksWithTies) {
   // Monotone but non-linear: 1; reversed: -1.
   EXPECT_NEAR(spearman(std::vector<double>{1, 2, 3, 4}, std::vector<double>{1, 8, 27, 1000}), 1.0, 1e-15);

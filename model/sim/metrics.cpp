@@ -426,16 +426,58 @@ Duration duration_td(std::span<const double> x, double fs) {
 }
 
 namespace {
-// max(0, |x[i]|) over [a, b), NaN skipped (std::max's order). Not inlined: in the caller, whose
-// result's address goes to require_finite, GCC kept the running maximum in memory (a store and
-// a reload per sample).
-[[gnu::noinline]] double max_abs(const double* x, std::size_t a, std::size_t b) {
-  double m = 0;
-  for (std::size_t i = a; i < b; ++i) m = std::max(m, std::abs(x[i]));
-  return m;
+// max(0, |x[i]|) over [a, b), NaN skipped: eight running maxima (blends; max is exact, so any
+// order gives it).
+RANGING_CLONE_V4 double max_abs(const double* x, std::size_t a, std::size_t b) {
+  typedef double V8 __attribute__((vector_size(64)));
+  const V8 zero = V8{};
+  V8 m = zero;
+  std::size_t i = a;
+  for (; i + 8 <= b; i += 8) {
+    V8 v;
+    std::memcpy(&v, x + i, sizeof v);
+    v = v < zero ? zero - v : v;
+    m = v > m ? v : m;
+  }
+  double r = 0;
+  for (int u = 0; u < 8; ++u) r = std::max(r, m[u]);
+  for (; i < b; ++i) r = std::max(r, std::abs(x[i]));
+  return r;
 }
+
+// The first i in [a, b) with |x[i]| == v, else b.
+RANGING_CLONE_V4 std::size_t first_abs_equal(const double* x, std::size_t a, std::size_t b, double v) {
+  for (std::size_t i = a; i < b; ++i) {
+    if (std::abs(x[i]) == v) return i;
+  }
+  return b;
+}
+
 }  // namespace
 
+double kth_smallest(double* m, std::size_t n, std::size_t k, double* buf) {
+  if (n >= 512) {
+    constexpr std::size_t kS = 128, kHalf = 12;
+    double s[kS];
+    for (std::size_t i = 0; i < kS; ++i) s[i] = m[i * n / kS];
+    std::sort(s, s + kS);
+    const std::size_t r = k * kS / n;
+    const double lo = s[r >= kHalf ? r - kHalf : 0], hi = s[std::min(kS - 1, r + kHalf)];
+    std::size_t below = 0, nb = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double v = m[i];
+      below += v < lo;
+      buf[nb] = v;
+      nb += (v >= lo) & (v <= hi);
+    }
+    if (below <= k && k < below + nb) {
+      std::nth_element(buf, buf + (k - below), buf + nb);
+      return buf[k - below];
+    }
+  }
+  std::nth_element(m, m + k, m + n);
+  return m[k];
+}
 StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std::size_t hi, std::size_t p0,
                                   std::size_t p1, std::size_t guard, double fs) {
   require_in_range("fs", fs, 1e-9, 1e12);
@@ -450,10 +492,10 @@ StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std
   StreamDuration d;
   const std::size_t n0 = lo > 2000 ? lo - 2000 : 0;
   if (lo - n0 >= 100) {
-    std::vector<double> m(lo - n0);
+    double m[2000], buf[2000];  // lo - n0 <= 2000
+    const std::size_t nm = lo - n0;
     for (std::size_t i = n0; i < lo; ++i) m[i - n0] = std::abs(x[i]);
-    std::nth_element(m.begin(), m.begin() + static_cast<long>(m.size() / 2), m.end());
-    d.noise_rms = m[m.size() / 2] / 0.6744897501960817;
+    d.noise_rms = kth_smallest(m, nm, nm / 2, buf) / 0.6744897501960817;
   }
   d.threshold = b / 10.0;
   if (4.5 * d.noise_rms > d.threshold) {
@@ -461,11 +503,7 @@ StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std
     d.noise_limited = true;
   }
   // The burst's peak, then outwards until `guard` consecutive samples are at or below a.
-  std::size_t pk = p0;
-  double top = std::abs(x[p0]);  // |x[pk]|
-  for (std::size_t i = p0; i < p1; ++i) {
-    if (const double a = std::abs(x[i]); a > top) top = a, pk = i;
-  }
+  std::size_t pk = first_abs_equal(x.data(), p0, p1, b);  // the first of the largest
   pk = std::clamp(pk, lo, hi - 1);
   const std::size_t gap = std::max<std::size_t>(guard, 1);
   // From the peak outwards over n samples one way (step +1 or -1): `edge` becomes the outermost
