@@ -353,6 +353,27 @@ TEST(StreamingDecode, RefusesWhatReadCaptureRefusesWithTheSameMessage) {
   }
 }
 
+// decode --json writes its detections' array on several threads, each element indented into
+// place: the text must be the very bytes nlohmann's dump(2) gives for the document, with more
+// than one chunk of elements (the 10-burst train tiled to over 512 bursts), on 1 and 2 threads.
+TEST(StreamingDecode, ToolJsonIsTheDocumentsOwnDump) {
+  Capture c = capture();
+  const std::vector<double> one = c.samples;
+  for (int k = 1; k < 53; ++k) c.samples.insert(c.samples.end(), one.begin(), one.end());
+  const std::string p = write("tiled.wav", capture_wav(c, WavFormat::Float32));
+  (void)write("tiled.json", capture_meta_json(c.meta));
+  std::string first;
+  for (const char* jobs : {"1", "2"}) {
+    const auto r = testing_support::run_tool("decode \"" + p + "\" --json --jobs " + jobs);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_GT(j["detections"].size(), 512u);
+    EXPECT_EQ(j.dump(2) + "\n", r.out) << "jobs " << jobs;
+    if (first.empty()) first = r.out;
+    EXPECT_EQ(r.out, first) << "jobs " << jobs;
+  }
+}
+
 TEST(StreamingDecode, ToolPrintsTheSameDetectionsAtAnyBlockSize) {
   Capture c = capture();
   const std::string p = write("tool.wav", capture_wav(c, WavFormat::Float32));

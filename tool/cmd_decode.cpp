@@ -14,6 +14,7 @@
 #include "model/sim/capture.hpp"
 #include "model/sim/capture_stream.hpp"
 #include "model/sim/capture_calibration.hpp"
+#include "model/base/parallel.hpp"
 #include "model/sim/metrics.hpp"
 #include "model/dsp/codes.hpp"
 #include "model/base/error.hpp"
@@ -28,6 +29,47 @@
 #include "tool/plot.hpp"
 
 namespace ranging::tool {
+
+namespace {
+// The text nlohmann's dump(2) writes for an array of to_json(v[i]) whose key sits at `depth`
+// (1: a key of the top-level object), each element dumped on its own on up to `jobs` threads
+// and indented into place: the same bytes as the array in the document.
+template <class T, class F>
+std::string json_array_text(const std::vector<T>& v, const F& to_json, int depth, int jobs) {
+  if (v.empty()) return "[]";
+  const std::string pad(static_cast<std::size_t>(2 * (depth + 1)), ' ');
+  std::vector<std::string> parts(v.size());
+  constexpr std::size_t kChunk = 512;
+  const std::size_t chunks = (v.size() + kChunk - 1) / kChunk;
+  parallel_items(chunks, std::min<std::size_t>(static_cast<std::size_t>(std::max(jobs, 1)), chunks),
+                 [&](std::size_t c, std::size_t) {
+                   for (std::size_t i = c * kChunk; i < std::min(v.size(), (c + 1) * kChunk); ++i) {
+                     const std::string e = to_json(v[i]).dump(2);
+                     std::string& out = parts[i];
+                     out.reserve(e.size() + 64);
+                     out += pad;
+                     for (const char ch : e) {
+                       out += ch;
+                       if (ch == '\n') out += pad;
+                     }
+                   }
+                 });
+  std::size_t total = 0;
+  for (const auto& p : parts) total += p.size() + 2;
+  std::string out;
+  out.reserve(total + 16);
+  out += "[\n";
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (i) out += ",\n";
+    out += parts[i];
+  }
+  out += "\n";
+  out.append(static_cast<std::size_t>(2 * depth), ' ');
+  out += "]";
+  return out;
+}
+}  // namespace
+
 
 namespace {
 
@@ -298,14 +340,20 @@ int cmd_decode(const Args& args) {
     if (meta.scene) j["scene"] = *meta.scene;
     if (meta.code_sent) j["code_sent"] = *meta.code_sent;
     if (meta.true_distance_m) j["true_distance_m"] = *meta.true_distance_m;
-    j["detections"] = nlohmann::json::array();
-    for (const auto& d : dets) j["detections"].push_back(det_json(d));
+    // The detections (50 000 in a 100 M-sample capture) are written on sim.jobs() threads, each
+    // element as dump(2) places it in the document; the document holds a marker in their place.
+    const std::string det_mark = "\\u0001detections\\u0001";  // as dump() escapes the marker
+    j["detections"] = "\x01" "detections" "\x01";
     j["below_gate"] = nlohmann::json::array();
     for (const auto& d : below) j["below_gate"].push_back(det_json(d));
     j["found"] = !dets.empty();
     j["input_clipping"] = {{"samples", clip.samples}, {"runs", clip.runs}, {"max", clip.high}, {"min", clip.low},
                            {"rule", "runs of >= 3 consecutive samples at the capture's maximum or minimum"}};
-    std::cout << stamp_build_info(j).dump(2) << "\n";
+    std::string text = stamp_build_info(j).dump(2);
+    const std::size_t at = text.find("\"" + det_mark + "\"");
+    if (at == std::string::npos) throw std::logic_error("decode --json: the detections' marker is missing");
+    text.replace(at, det_mark.size() + 2, json_array_text(dets, det_json, 1, sim.jobs()));
+    std::cout << text << "\n";
   } else {
     std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s%s%s\n",
                  family.c_str(), family_source.c_str(), c.value, c.source.c_str(), period.value,
