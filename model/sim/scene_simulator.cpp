@@ -1177,7 +1177,10 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     std::vector<std::size_t> open, active;  // end unknown yet / metrics pending
     long floor_used = std::numeric_limits<long>::min();  // the largest bound a burst relied on
     bool exact = true;
-    std::vector<double> w;  // w = f[base, base + w.size())
+    // The window: f[base, base + wn) in w[0, wn); w grows (zero-filled only then) but is not
+    // resized per block.
+    std::vector<double> w;
+    std::size_t wn = 0;
     long base = 0, read = 0;
     auto add_events = [&](const std::vector<Event>& from, std::size_t i0) {
       for (std::size_t i = i0; i < from.size(); ++i) {
@@ -1227,7 +1230,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     std::size_t k = src.read(x);
     for (bool last = false; !last;) {
       last = k == 0;
-      const std::size_t w0 = w.size();
+      const std::size_t w0 = wn;
       const long avail = base + static_cast<long>(w0);
       std::vector<std::size_t> ready;
       for (std::size_t i : active) {
@@ -1236,7 +1239,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       std::vector<char> done(ready.size(), 0);
       const std::size_t got0 = got.size();
       // the block's filtered samples go to the window's end; the metrics read what was there
-      if (metrics) w.resize(w0 + k);
+      if (metrics && w.size() < w0 + k) w.resize(std::max(w0 + k, 2 * w.size()));
       const std::span<const double> wr(w.data(), w0);
       const std::span<double> fk = metrics ? std::span<double>(w.data() + w0, k) : std::span<double>();
       const std::span<double> xk(x.data(), k);
@@ -1269,16 +1272,19 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       std::size_t r = 0;
       std::erase_if(active, [&](std::size_t i) { return r < ready.size() && ready[r] == i && done[r++]; });
       read += static_cast<long>(k);
+      if (metrics) wn += k;
       k = k_next;
       if (!known) add_events(got, got0);
       settle(events, read - lookback, last);
       if (!metrics) continue;
       // the samples still needed: the pending bursts', and those of events to come
-      long keep = std::min(base + static_cast<long>(w.size()), std::min(read - lookback, n - 1) - reach);
+      long keep = std::min(base + static_cast<long>(wn), std::min(read - lookback, n - 1) - reach);
       for (std::size_t i : active) keep = std::min(keep, needs[i].lo);
       for (std::size_t i : open) keep = std::min(keep, lk.need(n, starts[i]).lo);
-      if (keep - base >= static_cast<long>(block) && static_cast<std::size_t>(keep - base) * 2 >= w.size()) {
-        w.erase(w.begin(), w.begin() + (keep - base));
+      if (keep - base >= static_cast<long>(block) && static_cast<std::size_t>(keep - base) * 2 >= wn) {
+        const auto cut = static_cast<std::size_t>(keep - base);
+        std::copy(w.begin() + static_cast<std::ptrdiff_t>(cut), w.begin() + static_cast<std::ptrdiff_t>(wn), w.begin());
+        wn -= cut;
         base = keep;
       }
     }
@@ -1295,9 +1301,10 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
                    [&](std::size_t r, std::size_t t) {
                      PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
                      const auto i = active[r];
-                     done[r] = lk.metrics_window(pend[i].d, w, base, n, pend[i].start, pend[i].end, pb);
+                     done[r] = lk.metrics_window(pend[i].d, std::span<const double>(w.data(), wn), base, n,
+                                                 pend[i].start, pend[i].end, pb);
                    });
-    if (read != n || base + static_cast<long>(w.size()) != n || !open.empty() ||
+    if (read != n || base + static_cast<long>(wn) != n || !open.empty() ||
         std::find(done.begin(), done.end(), 0) != done.end()) {
       throw InputError(src.path() + ": changed while it was read");
     }
