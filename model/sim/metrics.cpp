@@ -14,6 +14,7 @@
 
 #include "model/base/error.hpp"
 #include "model/sim/fft.hpp"
+#include "model/base/transpose8.hpp"
 
 namespace ranging {
 
@@ -142,7 +143,36 @@ RANGING_CLONE_V4 void centred_sums(const double* x, std::size_t w, double* in, d
   const std::size_t len = (w + 7) / 8;
   double a1[8] = {0, 0, 0, 0, 0, 0, 0, 0}, a2[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   s1[0] = s2[0] = 0;
-  for (std::size_t j = 0; j < len; ++j) {
+  // While every chunk has eight more samples: chunk c on lane c, eight steps per 8 x 8
+  // transpose in and out (the scalar loop's operations, lane by lane).
+  typedef double V8 __attribute__((vector_size(64)));
+  const std::size_t full = w > 7 * len ? w - 7 * len : 0;  // samples every chunk has
+  const V8 m = V8{} + mean;
+  V8 c1{}, c2{};
+  std::size_t j = 0;
+  for (; j + 8 <= full; j += 8) {
+    V8 r[8], o1[8], o2[8];
+    for (std::size_t c = 0; c < 8; ++c) std::memcpy(&r[c], x + c * len + j, sizeof(V8));
+    transpose8(r);
+    for (std::size_t t = 0; t < 8; ++t) {
+      const V8 v = r[t] - m;
+      r[t] = v;
+      c1 += v;
+      c2 += v * v;
+      o1[t] = c1;
+      o2[t] = c2;
+    }
+    transpose8(r);
+    transpose8(o1);
+    transpose8(o2);
+    for (std::size_t c = 0; c < 8; ++c) {
+      std::memcpy(in + c * len + j, &r[c], sizeof(V8));
+      std::memcpy(s1 + c * len + j + 1, &o1[c], sizeof(V8));
+      std::memcpy(s2 + c * len + j + 1, &o2[c], sizeof(V8));
+    }
+  }
+  for (std::size_t c = 0; c < 8; ++c) a1[c] = c1[c], a2[c] = c2[c];
+  for (; j < len; ++j) {
     for (std::size_t c = 0; c < 8; ++c) {
       const std::size_t k = c * len + j;
       if (k >= w) continue;
