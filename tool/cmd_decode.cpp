@@ -48,9 +48,14 @@ std::string json_array_text(const std::vector<T>& v, const F& to_json, int depth
                      std::string& out = parts[i];
                      out.reserve(e.size() + 64);
                      out += pad;
-                     for (const char ch : e) {
-                       out += ch;
-                       if (ch == '\n') out += pad;
+                     for (std::size_t a = 0, b; a < e.size(); a = b + 1) {  // line by line
+                       b = e.find('\n', a);
+                       if (b == std::string::npos) {
+                         out.append(e, a, std::string::npos);
+                         break;
+                       }
+                       out.append(e, a, b + 1 - a);
+                       out += pad;
                      }
                    }
                  });
