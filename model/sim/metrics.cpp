@@ -12,6 +12,10 @@
 
 #include <fftw3.h>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "model/base/error.hpp"
 #include "model/sim/fft.hpp"
 #include "model/base/transpose8.hpp"
@@ -485,6 +489,46 @@ RANGING_CLONE_V4 std::size_t first_abs_equal(const double* x, std::size_t a, std
 
 }  // namespace
 
+namespace {
+// kth_smallest's pass: counts the m[i] < lo into below and keeps the m[i] in [lo, hi] in buf,
+// in order (NaN in neither); returns how many it kept. buf holds n values.
+std::size_t keep_between_scalar(const double* m, std::size_t n, double lo, double hi, double* buf, std::size_t& below) {
+  std::size_t nb = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v = m[i];
+    below += v < lo;
+    buf[nb] = v;  // branchless: kept when nb moves on
+    nb += (v >= lo) & (v <= hi);
+  }
+  return nb;
+}
+#if defined(__x86_64__)
+// The same, eight values per step: compare masks, a compress into a register (a compressing
+// store is microcoded and slow on some AVX-512 CPUs) and a full store (buf has room: nb <= i).
+[[gnu::target("avx512f")]] std::size_t keep_between_avx512(const double* m, std::size_t n, double lo, double hi,
+                                                          double* buf, std::size_t& below) {
+  const __m512d l = _mm512_set1_pd(lo), h = _mm512_set1_pd(hi);
+  std::size_t nb = 0, i = 0;
+  for (; i + 8 <= n; i += 8) {
+    const __m512d v = _mm512_loadu_pd(m + i);
+    const __mmask8 lt = _mm512_cmp_pd_mask(v, l, _CMP_LT_OQ);
+    const __mmask8 in = _mm512_cmp_pd_mask(v, l, _CMP_GE_OQ) & _mm512_cmp_pd_mask(v, h, _CMP_LE_OQ);
+    below += static_cast<std::size_t>(__builtin_popcount(lt));
+    _mm512_storeu_pd(buf + nb, _mm512_maskz_compress_pd(in, v));
+    nb += static_cast<std::size_t>(__builtin_popcount(in));
+  }
+  return nb + keep_between_scalar(m + i, n - i, lo, hi, buf + nb, below);
+}
+#endif
+std::size_t keep_between(const double* m, std::size_t n, double lo, double hi, double* buf, std::size_t& below) {
+#if defined(__x86_64__)
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  if (avx512) return keep_between_avx512(m, n, lo, hi, buf, below);
+#endif
+  return keep_between_scalar(m, n, lo, hi, buf, below);
+}
+}  // namespace
+
 double kth_smallest(double* m, std::size_t n, std::size_t k, double* buf) {
   if (n >= 512) {
     constexpr std::size_t kS = 128, kHalf = 12;
@@ -493,13 +537,8 @@ double kth_smallest(double* m, std::size_t n, std::size_t k, double* buf) {
     std::sort(s, s + kS);
     const std::size_t r = k * kS / n;
     const double lo = s[r >= kHalf ? r - kHalf : 0], hi = s[std::min(kS - 1, r + kHalf)];
-    std::size_t below = 0, nb = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double v = m[i];
-      below += v < lo;
-      buf[nb] = v;
-      nb += (v >= lo) & (v <= hi);
-    }
+    std::size_t below = 0;
+    const std::size_t nb = keep_between(m, n, lo, hi, buf, below);
     if (below <= k && k < below + nb) {
       std::nth_element(buf, buf + (k - below), buf + nb);
       return buf[k - below];
