@@ -17,7 +17,11 @@
 //   Adc             adc_quantize, the scenes' 12-bit ADC
 //   ChannelClean    propagate without noise: two transducers and the 64-tap fractional delay
 //                   (a scene computes this once per code and distance, then reuses it)
-// items_per_second = samples/s.
+// The decode's metrics of one burst (streaming decode, ranging decode):
+//   PearsonSearch   PearsonBank::search over the Gold4 decode's window: 9 references of 1000
+//                   samples, lags +-700 (2400 samples, 2560-point transforms); items = bursts/s
+//   DurationTd      duration_td_stream of one burst (noise median over 2000 samples, the walk)
+// items_per_second = samples/s (bursts/s for the two above).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -31,6 +35,7 @@
 #include "model/dsp/receiver_batch.hpp"
 #include "model/sim/channel.hpp"
 #include "model/sim/front_end.hpp"
+#include "model/sim/metrics.hpp"
 #include "model/sim/scene.hpp"
 
 int sc_main(int, char**) { return 0; }  // the bench programs link libsystemc, which references it
@@ -317,6 +322,45 @@ void BM_ChannelClean(benchmark::State& state) {
   items(state);
 }
 
+// A burst of reference 3 at lag 611 of a noisy 2400-sample window; every reference random.
+struct PearsonSetup {
+  std::vector<std::vector<double>> refs;
+  std::vector<double> x;
+};
+const PearsonSetup& pearson_setup() {
+  static const PearsonSetup s = [] {
+    PearsonSetup p;
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> g(0, 1);
+    for (int j = 0; j < 9; ++j) {
+      p.refs.emplace_back(1000);
+      for (double& v : p.refs.back()) v = g(rng);
+    }
+    p.x.resize(2400);
+    for (double& v : p.x) v = 0.3 * g(rng);
+    for (std::size_t i = 0; i < 1000; ++i) p.x[611 + i] += p.refs[2][i];
+    return p;
+  }();
+  return s;
+}
+
+void BM_PearsonSearch(benchmark::State& state) {
+  const PearsonSetup& s = pearson_setup();
+  PearsonBank bank(s.refs);
+  for (auto _ : state) benchmark::DoNotOptimize(bank.search(s.x, 0, 1400));
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_DurationTd(benchmark::State& state) {
+  const PearsonSetup& s = pearson_setup();
+  std::vector<double> x(2000, 0.0);
+  x.insert(x.end(), s.x.begin(), s.x.end());
+  for (auto _ : state) benchmark::DoNotOptimize(duration_td_stream(x, 2000, x.size(), 2611, 3611, 200, 5e6));
+  state.SetItemsProcessed(state.iterations());
+}
+
+BENCHMARK(BM_PearsonSearch)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DurationTd)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FixedBandpass)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FixedBank)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FixedReceiver)->Unit(benchmark::kMicrosecond);
