@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -178,6 +180,77 @@ TEST(StreamingDecode, ABrokenLookbackBoundFallsBackToTheSecondPass) {
           EXPECT_EQ(blocks, (whole.samples.size() + block - 1) / block) << "the scan sees each block once";
           EXPECT_EQ(sim.decode_passes(), lookback ? 2 : 1);
         }
+      }
+    }
+  }
+}
+
+// Scenes that name some metrics or none: the stream computes what decode() computes and leaves
+// the rest NaN as it does (bitwise: NaN fields compare by their bits), with or without the
+// window of the filtered stream, on 1 and 2 threads.
+TEST(StreamingDecode, OnlyTheNamedMetricsAsDecodeComputesThem) {
+  const std::string p = write("metrics.wav", capture_wav(capture(), WavFormat::Float32));
+  const Capture whole = read_capture(p);
+  auto bits = [](double v) {
+    std::uint64_t u;
+    std::memcpy(&u, &v, sizeof u);
+    return u;
+  };
+  for (const char* metrics : {"[]", "[td]", "[energy]", "[pearson]", "[td, energy]"}) {
+    for (const char* precision : {"float", "fixed"}) {
+      SceneSimulator sim(parse_scene("name: decode\nsample_rate: 5000000\nmedium:\n  speed_of_sound: 343\ntransducers: {}\n"
+                                     "geometry:\n  distances_m: [1.0]\nexcitation:\n  family: Gold4\nreceiver:\n  precision: " +
+                                         std::string(precision) + "\n  metrics: " + metrics + "\n",
+                                     "decode.yaml"));
+      const auto ref = sim.decode("Gold4", whole.samples, whole.t0, 0.002);
+      ASSERT_GE(ref.size(), 10u);
+      CaptureSource src(p);
+      for (int jobs : {1, 2}) {
+        sim.set_jobs(jobs);
+        for (std::size_t block : {std::size_t{997}, std::size_t{1} << 20}) {
+          SCOPED_TRACE(std::string(metrics) + " " + precision + ", jobs " + std::to_string(jobs) + ", block " +
+                       std::to_string(block));
+          const auto got = sim.decode_stream("Gold4", src, 0.002, block);
+          ASSERT_EQ(got.size(), ref.size());
+          for (std::size_t i = 0; i < ref.size(); ++i) {
+            EXPECT_EQ(got[i].arrival_s, ref[i].arrival_s);
+            EXPECT_EQ(bits(got[i].td_s), bits(ref[i].td_s)) << i;
+            EXPECT_EQ(bits(got[i].energy), bits(ref[i].energy)) << i;
+            EXPECT_EQ(bits(got[i].rho_max), bits(ref[i].rho_max)) << i;
+            EXPECT_EQ(got[i].rho, ref[i].rho) << i;
+          }
+          const bool named_td = std::string(metrics).find("td") != std::string::npos;
+          EXPECT_EQ(std::isnan(got[0].td_s), !named_td);
+        }
+      }
+    }
+  }
+}
+
+// Captures with nothing to find: noise alone, silence, a stream shorter than a template, the
+// first burst cut by the start: the stream's detections are decode()'s (none, or the same).
+TEST(StreamingDecode, EmptyNoiseAndCutCapturesAsDecode) {
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> g(0, 0.01);
+  std::vector<std::pair<std::string, std::vector<double>>> cases;
+  cases.emplace_back("noise", std::vector<double>(60000));
+  for (double& v : cases.back().second) v = g(rng);
+  cases.emplace_back("silence", std::vector<double>(5000, 0.0));
+  cases.emplace_back("short", std::vector<double>(capture().samples.begin(), capture().samples.begin() + 700));
+  cases.emplace_back("cut", std::vector<double>(capture().samples.begin() + 2500, capture().samples.end()));
+  for (const auto& [name, x] : cases) {
+    Capture c;
+    c.sample_rate = 5e6;
+    c.samples = x;
+    const std::string p = write(name + ".wav", capture_wav(c, WavFormat::Float64));
+    for (const std::string precision : {"float", "fixed"}) {
+      SceneSimulator sim(decode_scene(precision));
+      const auto ref = sim.decode("Gold4", x, 0, 0.002);
+      CaptureSource src(p);
+      for (int jobs : {1, 2}) {
+        sim.set_jobs(jobs);
+        SCOPED_TRACE(name + " " + precision + ", jobs " + std::to_string(jobs));
+        expect_same(ref, sim.decode_stream("Gold4", src, 0.002, 4096));
       }
     }
   }
