@@ -127,6 +127,29 @@ namespace {
 #define RANGING_CLONE_V4
 #endif
 
+typedef double V8 __attribute__((vector_size(64)));
+// The largest / smallest of the eight lanes, by blends and whole-vector shuffles (GCC 12 turns a
+// vector of comparison masks into scalar inserts; blends it keeps in the vector unit). Inlined
+// into each clone (no ISA of their own).
+[[gnu::always_inline]] inline double lanes_max(V8 m) {
+  V8 t = __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3);
+  m = m > t ? m : t;
+  t = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
+  m = m > t ? m : t;
+  t = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
+  m = m > t ? m : t;
+  return m[0];
+}
+[[gnu::always_inline]] inline double lanes_min(V8 m) {
+  V8 t = __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3);
+  m = m < t ? m : t;
+  t = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
+  m = m < t ? m : t;
+  t = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
+  m = m < t ? m : t;
+  return m[0];
+}
+
 // The centred window's sums, in eight independent chains (a single running sum is one add per
 // four cycles; eight keep the adder busy), every operation in a fixed order, so the AVX-512
 // clone and the baseline give the same bits:
@@ -149,7 +172,6 @@ RANGING_CLONE_V4 void centred_sums(const double* x, std::size_t w, double* in, d
   s1[0] = s2[0] = 0;
   // While every chunk has eight more samples: chunk c on lane c, eight steps per 8 x 8
   // transpose in and out (the scalar loop's operations, lane by lane).
-  typedef double V8 __attribute__((vector_size(64)));
   const std::size_t full = w > 7 * len ? w - 7 * len : 0;  // samples every chunk has
   const V8 m = V8{} + mean;
   V8 c1{}, c2{};
@@ -235,7 +257,6 @@ RANGING_CLONE_V4 void lag_norms(const double* s1, const double* s2, std::size_t 
 // any order of the maximum gives it, so the AVX-512 clone gives the baseline's bits).
 // Eight running maxima in one vector (the compiler does not vectorize a max reduction itself).
 RANGING_CLONE_V4 double screen_products(const double* o, const double* inv_den, std::size_t lags, double* g) {
-  typedef double V8 __attribute__((vector_size(64)));
   V8 m = V8{} - HUGE_VAL;
   std::size_t k = 0;
   for (; k + 8 <= lags; k += 8) {
@@ -258,20 +279,11 @@ RANGING_CLONE_V4 double screen_products(const double* o, const double* inv_den, 
 // The indices k < lags with g_k >= lo, in increasing order, into idx; returns how many. Eight
 // lags per compare: a group none of whose lags passes (most) is skipped in one test.
 RANGING_CLONE_V4 std::size_t lags_at_least(const double* g, std::size_t lags, double lo, std::size_t* idx) {
-  typedef double V8 __attribute__((vector_size(64)));
   std::size_t c = 0, k = 0;
   for (; k + 8 <= lags; k += 8) {
     V8 a;
     std::memcpy(&a, g + k, sizeof a);
-    // the group's largest (max blends and whole-vector shuffles: GCC 12 turns a vector of
-    // comparison masks into scalar code, a blend it keeps in the vector unit)
-    V8 m = __builtin_shufflevector(a, a, 4, 5, 6, 7, 0, 1, 2, 3);
-    m = a > m ? a : m;
-    V8 t = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
-    m = m > t ? m : t;
-    t = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
-    m = m > t ? m : t;
-    if (!(m[0] >= lo)) continue;
+    if (!(lanes_max(a) >= lo)) continue;
     for (std::size_t u = k; u < k + 8; ++u) {
       if (g[u] >= lo) idx[c++] = u;
     }
@@ -285,7 +297,6 @@ RANGING_CLONE_V4 std::size_t lags_at_least(const double* g, std::size_t lags, do
 // prod_i = spec_i ts_i for i < nc, interleaved complex (re, im): (ac - bd) + i(ad + bc), each a
 // product then a sum, never fused. Four products per step.
 RANGING_CLONE_V4 void spectrum_product(const double* spec, const double* ts, double* prod, std::size_t nc) {
-  typedef double V8 __attribute__((vector_size(64)));
   typedef std::int64_t I8 __attribute__((vector_size(64)));
   constexpr std::int64_t s = std::numeric_limits<std::int64_t>::min();  // the sign bit
   const I8 neg_even = {s, 0, s, 0, s, 0, s, 0};
@@ -463,7 +474,6 @@ namespace {
 // max(0, |x[i]|) over [a, b), NaN skipped: eight running maxima (blends; max is exact, so any
 // order gives it).
 RANGING_CLONE_V4 double max_abs(const double* x, std::size_t a, std::size_t b) {
-  typedef double V8 __attribute__((vector_size(64)));
   const V8 zero = V8{};
   V8 m = zero;
   std::size_t i = a;
@@ -654,7 +664,6 @@ namespace {
 // holds a NaN or the result is a zero (whose sign then depends on the order: the caller takes
 // std::minmax_element's then).
 RANGING_CLONE_V4 bool extremes(const double* x, std::size_t n, double& lo, double& hi) {
-  typedef double V8 __attribute__((vector_size(64)));
   V8 mx = V8{} + x[0], mn = mx, nan = V8{};
   std::size_t k = 0;
   for (; k + 8 <= n; k += 8) {
@@ -676,7 +685,6 @@ RANGING_CLONE_V4 bool extremes(const double* x, std::size_t n, double& lo, doubl
 // when x == a). Eight lanes per step: the group's smallest min(|x - a|, |x - b|), by blends and
 // whole-vector shuffles, is tested against 0.
 RANGING_CLONE_V4 std::size_t find_either(const double* x, std::size_t n, double a, double b) {
-  typedef double V8 __attribute__((vector_size(64)));
   const V8 av = V8{} + a, bv = V8{} + b, zero = V8{};
   std::size_t k = 0;
   for (; k + 8 <= n; k += 8) {
@@ -685,14 +693,7 @@ RANGING_CLONE_V4 std::size_t find_either(const double* x, std::size_t n, double 
     V8 da = v - av, db = v - bv;
     da = da < zero ? zero - da : da;
     db = db < zero ? zero - db : db;
-    V8 m = da < db ? da : db;
-    V8 t = __builtin_shufflevector(m, m, 4, 5, 6, 7, 0, 1, 2, 3);
-    m = m < t ? m : t;
-    t = __builtin_shufflevector(m, m, 2, 3, 0, 1, 6, 7, 4, 5);
-    m = m < t ? m : t;
-    t = __builtin_shufflevector(m, m, 1, 0, 3, 2, 5, 4, 7, 6);
-    m = m < t ? m : t;
-    if (m[0] == 0) break;
+    if (lanes_min(da < db ? da : db) == 0) break;
   }
   for (; k < n; ++k) {
     if (x[k] == a || x[k] == b) return k;

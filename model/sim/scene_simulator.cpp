@@ -310,7 +310,7 @@ struct SceneSimulator::Link {
     for (std::size_t n0 = 0; n0 < volts.size(); n0 += kChunk) {
       const std::size_t n1 = std::min(volts.size(), n0 + kChunk);
       std::int64_t* q = raw.data() + (observed ? n0 : 0);
-      quantize_codes(volts, n0, n1, inv, q, adc, clamped);
+      quantize_codes(volts, n0, n1, inv, design.config.bandpass.input_bits, q, adc, clamped);
       rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
       if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only
         bp.execute_block(std::span<const double>(volts.data() + n0, n1 - n0),
@@ -324,11 +324,10 @@ struct SceneSimulator::Link {
     return ev;
   }
 
-  // The ADC codes of volts[n0, n1) / scale, as ReceiverFixed::execute(double) quantizes them,
-  // into q[0, n1 - n0); appends the indices the clamp to +-scale cut to *clamped.
-  void quantize_codes(const std::vector<double>& volts, std::size_t n0, std::size_t n1, double inv, std::int64_t* q,
-                      OverflowCounter& adc, std::vector<std::size_t>* clamped) const {
-    const int bits = design.config.bandpass.input_bits;
+  // The ADC codes (bits wide) of volts[n0, n1) / scale, as ReceiverFixed::execute(double)
+  // quantizes them, into q[0, n1 - n0); appends the indices the clamp to +-scale cut to *clamped.
+  static void quantize_codes(std::span<const double> volts, std::size_t n0, std::size_t n1, double inv, int bits,
+                             std::int64_t* q, OverflowCounter& adc, std::vector<std::size_t>* clamped) {
     for (std::size_t n = n0; n < n1; ++n) {
       if (clamped && std::abs(volts[n] * inv) > 1.0) clamped->push_back(n);
       q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), bits, &adc);
@@ -378,7 +377,8 @@ struct SceneSimulator::Link {
     for (std::size_t i = 0; i < streams.size(); ++i) {
       const auto& v = *streams[i].volts;
       codes[i].resize(v.size());
-      quantize_codes(v, 0, v.size(), inv, codes[i].data(), adc[i], streams[i].clamped);
+      quantize_codes(v, 0, v.size(), inv, design.config.bandpass.input_bits, codes[i].data(), adc[i],
+                     streams[i].clamped);
       spans.emplace_back(codes[i]);
     }
     std::vector<std::vector<EventFixed>> raw;
@@ -403,7 +403,8 @@ struct SceneSimulator::Link {
   // after the last (the detector's pending candidate).
   class StreamReceiver {
    public:
-    StreamReceiver(const Link& lk, double scale) : lk_(lk), scale_(scale), inv_(1.0 / scale) {
+    StreamReceiver(const Link& lk, double scale)
+        : scale_(scale), inv_(1.0 / scale), rx_bits_(lk.design.config.bandpass.input_bits) {
       if (lk.fixed()) {
         rx_.emplace(lk.design);
       } else {
@@ -421,9 +422,7 @@ struct SceneSimulator::Link {
         return;
       }
       raw_.resize(x.size());
-      for (std::size_t i = 0; i < x.size(); ++i) {
-        raw_[i] = quantize_input(std::clamp(x[i] * inv_, -1.0, 1.0), lk_.design.config.bandpass.input_bits, &adc_);
-      }
+      quantize_codes(x, 0, x.size(), inv_, rx_bits_, raw_.data(), adc_, nullptr);
       raw_events_.clear();
       rx_->execute_block(std::span<const std::int64_t>(raw_.data(), x.size()), raw_events_);
       for (const auto& e : raw_events_) ev.push_back(rx_->to_float(e));
@@ -433,8 +432,8 @@ struct SceneSimulator::Link {
     }
 
    private:
-    const Link& lk_;
     double scale_, inv_;
+    int rx_bits_;  // the fixed receiver's input word
     std::optional<ReceiverFloat> rf_;
     std::optional<ReceiverFixed> rx_;
     OverflowCounter adc_;
@@ -1224,6 +1223,12 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     if (scene_.receiver.metrics.pearson) {
       for (int t = 1; t < jobs_; ++t) banks.push_back(std::make_unique<PearsonBank>(lk.templates));
     }
+    // Burst i's metrics on window wr, on worker thread t (thread 0 uses lk.bank; without Pearson
+    // outputs no bank is used and banks is empty); false: its T_d search needs more samples.
+    auto metrics_of = [&](std::size_t i, std::span<const double> wr, std::size_t t) -> char {
+      PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
+      return lk.metrics_window(pend[i].d, wr, base, n, pend[i].start, pend[i].end, pb);
+    };
     // Blocks are read one ahead (item 1 of a round reads the next while item 0 receives this one).
     std::vector<double> xn(block);
     src.rewind();
@@ -1261,11 +1266,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
                          return;
                        }
                        if (item == 2 && first == 3) return bp.execute_block(xk, fk);
-                       const std::size_t r = item - first;
-                       // thread 0 uses lk.bank; without Pearson outputs no bank is used and banks is empty
-                       PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
-                       const auto i = ready[r];
-                       done[r] = lk.metrics_window(pend[i].d, wr, base, n, pend[i].start, pend[i].end, pb);
+                       done[item - first] = metrics_of(ready[item - first], wr, t);
                      });
       x.swap(xn);
       // ready is a subsequence of active, in order: one pass drops the finished ones
@@ -1299,10 +1300,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     std::vector<char> done(active.size(), 0);
     parallel_items(active.size(), std::min<std::size_t>(std::max(jobs_, 1), active.size()),
                    [&](std::size_t r, std::size_t t) {
-                     PearsonBank& pb = (t == 0 || banks.empty()) ? *lk.bank : *banks[t - 1];
-                     const auto i = active[r];
-                     done[r] = lk.metrics_window(pend[i].d, std::span<const double>(w.data(), wn), base, n,
-                                                 pend[i].start, pend[i].end, pb);
+                     done[r] = metrics_of(active[r], std::span<const double>(w.data(), wn), t);
                    });
     if (read != n || base + static_cast<long>(wn) != n || !open.empty() ||
         std::find(done.begin(), done.end(), 0) != done.end()) {
