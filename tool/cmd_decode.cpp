@@ -161,12 +161,13 @@ int cmd_decode(const Args& args) {
   p.option("--distance", "M", "the distance of the --calibrate capture, 0.001..1000 m");
   p.option("--plot", "FILE.png", "draw the capture, the bandpass output and the bank's rho^2 per code with the detections");
   add_output_options(p, {.json = true});
-  p.option("--block-samples", "N", "the capture is streamed in blocks of N samples, 64..67108864 (memory, not results, depends on it)", "1048576");
+  p.option("--block-samples", "N", "the capture is streamed in blocks of N samples, 64..67108864 (memory and speed, not results, depend on it); auto: the capture's length / 64 rounded down to a power of two, within 65536..1048576", "auto");
   add_jobs_option(p, "bursts' metrics (Pearson rho, T_d, energy) computed");
   if (!p.parse(args)) return 0;
   const std::string path = p.positionals().at(0);
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
-  const auto block = static_cast<std::size_t>(p.integer("--block-samples", 1 << 20, 64, 1 << 26));
+  std::optional<std::size_t> block_option;
+  if (p.has("--block-samples")) block_option = static_cast<std::size_t>(p.integer("--block-samples", 1 << 16, 64, 1 << 26));
   const int channel = static_cast<int>(p.integer("--channel", 1, 1, 65535));
   const CaptureRead how{channel, p.has("--sample-rate") ? p.number("--sample-rate", 0, 1e4, 1e9) : 0.0};
   // Streamed (model/sim/capture_stream.hpp): validated whole at open, then read in blocks.
@@ -277,6 +278,11 @@ int cmd_decode(const Args& args) {
     }
   };
   check_len(cap.size(), path);
+  // Blocks of >= kBandpassSplitMin samples run the bandpass on its SIMD lanes (time split), but
+  // each sample of a block's buffers is fresh memory once (a page fault per 4 KiB) and the first
+  // block's receiver runs alone: long blocks pay on long captures only.
+  std::size_t block = block_option.value_or(std::size_t{1} << 16);
+  while (!block_option && block < (std::size_t{1} << 20) && 2 * block <= cap.size() / 64) block *= 2;
   SceneSimulator sim(scene);
   sim.set_jobs(jobs_option(p));
 

@@ -5,6 +5,8 @@
 // AVX-512 load of it then touches two lines). AlignedVector<T> = std::vector of 64-byte aligned data.
 #include <cstddef>
 #include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace ranging {
@@ -30,5 +32,31 @@ struct AlignedAllocator {
 
 template <class T>
 using AlignedVector = std::vector<T, AlignedAllocator<T, 64>>;
+
+// BufferVector<T>: an AlignedVector whose resize() leaves the new elements default-initialized
+// (for double: no zero fill, no write at all), for a buffer that is always written before it is
+// read. A growing stream window then costs no pass over fresh memory (zeroing it is a page fault
+// per 4 KiB on top of the write that follows).
+template <class T>
+struct BufferAllocator : AlignedAllocator<T, 64> {
+  template <class U>
+  struct rebind {
+    using other = BufferAllocator<U>;
+  };
+  BufferAllocator() = default;
+  template <class U>
+  BufferAllocator(const BufferAllocator<U>&) {}
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+template <class T>
+using BufferVector = std::vector<T, BufferAllocator<T>>;
 
 }  // namespace ranging

@@ -1176,9 +1176,11 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     std::vector<std::size_t> open, active;  // end unknown yet / metrics pending
     long floor_used = std::numeric_limits<long>::min();  // the largest bound a burst relied on
     bool exact = true;
-    // The window: f[base, base + wn) in w[0, wn); w grows (zero-filled only then) but is not
-    // resized per block.
-    std::vector<double> w;
+    // The window: f[base, base + wn) in w[0, wn); w grows (never zero-filled: every sample is the
+    // receiver's before it is read) but is not resized per block. Once the samples no longer
+    // needed are at least half of it, the rest moves to the front (a copy of at most what is
+    // dropped: amortized, under one copy per sample).
+    BufferVector<double> w;
     std::size_t wn = 0;
     long base = 0, read = 0;
     auto add_events = [&](const std::vector<Event>& from, std::size_t i0) {
@@ -1282,7 +1284,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       long keep = std::min(base + static_cast<long>(wn), std::min(read - lookback, n - 1) - reach);
       for (std::size_t i : active) keep = std::min(keep, needs[i].lo);
       for (std::size_t i : open) keep = std::min(keep, lk.need(n, starts[i]).lo);
-      if (keep - base >= static_cast<long>(block) && static_cast<std::size_t>(keep - base) * 2 >= wn) {
+      if (keep > base && static_cast<std::size_t>(keep - base) * 2 >= wn) {
         const auto cut = static_cast<std::size_t>(keep - base);
         std::copy(w.begin() + static_cast<std::ptrdiff_t>(cut), w.begin() + static_cast<std::ptrdiff_t>(wn), w.begin());
         wn -= cut;

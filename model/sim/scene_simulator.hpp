@@ -191,7 +191,7 @@ class SceneSimulator {
   // the capture, in order, as the receiver's pass reads it (a caller's own scan without a read
   // of its own).
   std::vector<Detection> decode_stream(const std::string& family, CaptureSource& src, double period_s = 0,
-                                       std::size_t block = std::size_t{1} << 20, std::optional<double> peak = {},
+                                       std::size_t block = std::size_t{1} << 16, std::optional<double> peak = {},
                                        const std::function<void(std::span<const double>)>& on_block = {});
 
   // The receiver of the scene's precision over a stream of volts at the scene's input scale
