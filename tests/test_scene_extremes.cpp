@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -335,6 +336,42 @@ TEST(FlatTopClipping, LevelsAreMinmaxElementsValues) {
     const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
     EXPECT_EQ(std::signbit(scan.result().high), std::signbit(*hi));
     EXPECT_EQ(std::signbit(scan.result().low), std::signbit(*lo));
+  }
+}
+
+// levels() over consecutive parts on scans of their own, merged in order, gives the one scan's
+// levels: the same values and, for signed zeros, the same signs (the first of its value).
+TEST(FlatTopClipping, LevelsMergedFromPartsAreTheOneScansLevels) {
+  std::mt19937_64 rng(12);
+  std::vector<std::vector<double>> cases = {{-0.0, 0.0, -0.0, 0.0}, {0.0, -0.0, 0.0, -0.0}, std::vector<double>(24, -0.0)};
+  for (int r = 0; r < 60; ++r) {  // ties everywhere; zeros of both signs as the maximum, the minimum, or inside
+    std::vector<double> x(37);
+    const int lo = r % 3 == 1 ? 0 : -2, hi = r % 3 == 0 ? 0 : 2;
+    for (double& v : x) v = std::uniform_int_distribution<int>(lo, hi)(rng) * 0.5;
+    for (double& v : x) v = v == 0.0 && rng() % 2 ? -0.0 : v;
+    cases.push_back(x);
+  }
+  for (const auto& x : cases) {
+    const std::size_t blk = 2;  // the blocks both ways see
+    FlatTopScan one;
+    for (std::size_t i = 0; i < x.size(); i += blk) one.levels(std::span<const double>(x).subspan(i, std::min(blk, x.size() - i)));
+    for (std::size_t parts = 1; parts <= 5; ++parts) {
+      const std::size_t blocks = (x.size() + blk - 1) / blk;
+      FlatTopScan merged;
+      merged.merge_levels(FlatTopScan());  // an empty part changes nothing
+      for (std::size_t p = 0; p < parts; ++p) {
+        FlatTopScan part;
+        for (std::size_t b = p * blocks / parts; b < (p + 1) * blocks / parts; ++b) {
+          part.levels(std::span<const double>(x).subspan(b * blk, std::min(blk, x.size() - b * blk)));
+        }
+        merged.merge_levels(part);
+      }
+      const FlatTops a = one.result(), m = merged.result();
+      EXPECT_EQ(m.high, a.high) << parts;
+      EXPECT_EQ(m.low, a.low) << parts;
+      EXPECT_EQ(std::signbit(m.high), std::signbit(a.high)) << parts;
+      EXPECT_EQ(std::signbit(m.low), std::signbit(a.low)) << parts;
+    }
   }
 }
 

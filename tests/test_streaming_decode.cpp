@@ -275,6 +275,91 @@ TEST(StreamingDecode, TheOpenScanSeesTheSamplesReadGives) {
   }
 }
 
+// The scan in parts (decode --jobs): a WAV's samples in consecutive runs of whole 65536-sample
+// blocks, part p's before part p + 1's, each part's blocks in order and those of the one-part
+// scan; a CSV is one part; more parts than blocks leave the rest unused.
+TEST(StreamingDecode, TheOpenScanInPartsSeesEveryBlockOnce) {
+  Capture c;
+  c.sample_rate = 1e6;
+  std::mt19937_64 rng(5);
+  c.samples.resize(3 * 65536 + 1234);
+  for (double& v : c.samples) v = std::uniform_real_distribution<double>(-0.9, 0.9)(rng);
+  Capture small = c;
+  small.samples.resize(70000);
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"parts32f.wav", capture_wav(c, WavFormat::Float32)},
+      {"parts16.wav", capture_wav(c, WavFormat::Pcm16, 1.0)},
+      {"parts.csv", capture_csv(small)}};
+  for (const auto& [name, bytes] : files) {
+    const std::string p = write(name, bytes);
+    const std::vector<double> whole = read_capture(p).samples;
+    for (std::size_t parts : {1, 2, 3, 4, 9}) {
+      std::vector<std::vector<std::vector<double>>> seen(parts);  // part -> its blocks (one thread each)
+      CaptureSource src(
+          p, {}, [&](std::size_t part, std::span<const double> x) { seen.at(part).emplace_back(x.begin(), x.end()); },
+          parts);
+      std::vector<double> all;
+      std::vector<std::size_t> sizes;
+      std::size_t used = 0;
+      for (const auto& part : seen) {
+        used += !part.empty();
+        for (const auto& b : part) {
+          sizes.push_back(b.size());
+          all.insert(all.end(), b.begin(), b.end());
+        }
+      }
+      EXPECT_EQ(all, whole) << name << " parts " << parts;
+      if (name.ends_with(".wav")) {
+        EXPECT_EQ(sizes, (std::vector<std::size_t>{65536, 65536, 65536, 1234})) << name << " parts " << parts;
+        EXPECT_EQ(used, std::min<std::size_t>(parts, 4)) << name;
+      } else {
+        EXPECT_EQ(used, 1u) << name;
+      }
+      std::vector<double> again(whole.size());  // the samples still read from the start
+      EXPECT_EQ(src.read(again), whole.size());
+      EXPECT_EQ(again, whole);
+    }
+  }
+}
+
+// Whatever the parts, the open pass reports the file's first invalid sample, with read_capture's
+// message (each part stops at its own first; the first part's error is the one rethrown).
+TEST(StreamingDecode, TheOpenScanInPartsReportsTheFirstInvalidSample) {
+  Capture c;
+  c.sample_rate = 1e6;
+  c.samples.assign(4 * 65536, 0.25);
+  const std::string wav = capture_wav(c, WavFormat::Float32);
+  auto poison = [](std::string w, std::size_t k, std::uint32_t bits) {  // sample k := the float of bits
+    const std::size_t at = w.size() - 4 * (4 * 65536 - k);  // the data chunk ends the file
+    for (int i = 0; i < 4; ++i) w[at + static_cast<std::size_t>(i)] = static_cast<char>((bits >> (8 * i)) & 0xff);
+    return w;
+  };
+  const std::uint32_t qnan = 0x7fc00000u, inf = 0x7f800000u;
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"two_bad.wav", poison(poison(wav, 70000, qnan), 250000, inf)},
+      {"late_bad.wav", poison(wav, 250000, inf)},
+      {"first_bad.wav", poison(poison(wav, 0, inf), 3 * 65536, qnan)}};
+  for (const auto& [name, bytes] : bad) {
+    const std::string p = write(name, bytes);
+    std::string whole;
+    try {
+      (void)read_capture(p);
+    } catch (const InputError& e) {
+      whole = e.what();
+    }
+    ASSERT_FALSE(whole.empty()) << name;
+    for (std::size_t parts : {1, 2, 3, 4}) {
+      std::string streamed;
+      try {
+        CaptureSource s(p, {}, [](std::size_t, std::span<const double>) {}, parts);
+      } catch (const InputError& e) {
+        streamed = e.what();
+      }
+      EXPECT_EQ(streamed, whole) << name << " parts " << parts;
+    }
+  }
+}
+
 TEST(StreamingDecode, SamplesAndMetadataAsReadCapture) {
   for (const char* name : {"meta.wav", "meta.csv"}) {
     Capture c = capture();

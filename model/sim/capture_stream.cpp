@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "model/base/error.hpp"
+#include "model/base/parallel.hpp"
 #include "model/base/input_file.hpp"
 
 namespace ranging {
@@ -18,7 +19,13 @@ constexpr std::size_t kWavBlockBytes = std::size_t{1} << 20;
 
 CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how,
                              const std::function<void(std::span<const double>)>& scan)
+    : CaptureSource(path, how, scan ? PartScan([&scan](std::size_t, std::span<const double> x) { scan(x); }) : PartScan(),
+                    1) {}
+
+CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& part_scan,
+                             std::size_t parts)
     : path_(path) {
+  const auto scan = [&](std::span<const double> x) { part_scan(0, x); };  // a CSV: one part
   std::vector<double> block;  // scan's samples
   std::string ext;
   if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
@@ -41,7 +48,7 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how,
     std::string line;
     double t = 0, v = 0;
     while (std::getline(in_, line)) {
-      if (!rows.line(line, t, v) || !scan) continue;
+      if (!rows.line(line, t, v) || !part_scan) continue;
       block.push_back(v);
       if (block.size() == 4096) {
         scan(block);
@@ -50,7 +57,7 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how,
     }
     if (in_.bad()) throw InputError(path + ": cannot read the capture file");
     rows.finish();
-    if (scan && !block.empty()) scan(block);
+    if (part_scan && !block.empty()) scan(block);
     // Second pass: every row on the uniform grid (the rows are known to be well formed now).
     in_.clear();
     in_.seekg(0);
@@ -82,12 +89,32 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how,
     file_rate_ = wav_.rate;
     rate_ = how.sample_rate > 0 ? how.sample_rate : wav_.rate;
     n_ = wav_.n;
-    if (wav_.flt || n_ < 2 || scan) {  // NaN/Inf are refused before anything is decoded (read_capture's order)
-      rewind();
-      block.resize(std::size_t{1} << 16);
-      for (std::size_t k; (k = read(block)) > 0;) {
-        if (scan) scan(std::span<const double>(block.data(), k));
-      }
+    if (wav_.flt || n_ < 2 || part_scan) {  // NaN/Inf are refused before anything is decoded (read_capture's order)
+      // Blocks of 2^16 frames; part p reads blocks [p B / P, (p + 1) B / P) through a stream of
+      // its own. Each part stops at its first invalid sample; parallel_items rethrows the first
+      // part's error, so the file's first invalid sample is the one reported.
+      constexpr std::size_t kScan = std::size_t{1} << 16;
+      const std::size_t blocks = (n_ + kScan - 1) / kScan;
+      const std::size_t np = std::clamp<std::size_t>(parts, 1, std::max<std::size_t>(blocks, 1));
+      parallel_items(np, np, [&](std::size_t part, std::size_t) {
+        const std::size_t b0 = part * blocks / np, b1 = (part + 1) * blocks / np;
+        if (b0 == b1) return;
+        std::ifstream own;
+        if (part > 0) {
+          own.open(path, std::ios::binary);
+          if (!own) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
+        }
+        std::ifstream& in = part > 0 ? own : in_;
+        in.clear();
+        in.seekg(static_cast<std::streamoff>(wav_.body + b0 * kScan * wav_.frame));
+        std::string bytes;
+        std::vector<double> out(kScan);
+        for (std::size_t b = b0; b < b1; ++b) {
+          const std::size_t m = std::min(kScan, n_ - b * kScan);
+          wav_frames(in, bytes, b * kScan, m, out.data());
+          if (part_scan) part_scan(part, std::span<const double>(out.data(), m));
+        }
+      });
     }
     if (n_ < 2) throw InputError(path + ": byte " + std::to_string(wav_.chunk_at) + ": the data chunk holds fewer than two samples");
   }
@@ -123,18 +150,22 @@ std::size_t CaptureSource::read(std::span<double> out) {
     return k;
   }
   const std::size_t want = std::min(out.size(), n_ - pos_);
-  while (k < want) {
-    const std::size_t frames = std::min(want - k, std::max<std::size_t>(kWavBlockBytes / wav_.frame, 1));
-    buf_.resize(frames * wav_.frame);
-    in_.read(buf_.data(), static_cast<std::streamsize>(buf_.size()));
-    if (static_cast<std::size_t>(in_.gcount()) != buf_.size()) {
+  wav_frames(in_, buf_, pos_, want, out.data());
+  pos_ += want;
+  return want;
+}
+
+void CaptureSource::wav_frames(std::ifstream& in, std::string& buf, std::size_t i0, std::size_t m, double* out) const {
+  for (std::size_t k = 0; k < m;) {
+    const std::size_t frames = std::min(m - k, std::max<std::size_t>(kWavBlockBytes / wav_.frame, 1));
+    buf.resize(frames * wav_.frame);
+    in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
+    if (static_cast<std::size_t>(in.gcount()) != buf.size()) {
       throw InputError(path_ + ": changed while it was read (shorter than its data chunk)");
     }
-    wav_samples(buf_.data(), frames, wav_, path_, pos_, out.data() + k);
+    wav_samples(buf.data(), frames, wav_, path_, i0 + k, out + k);
     k += frames;
-    pos_ += frames;
   }
-  return k;
 }
 
 }  // namespace ranging

@@ -93,6 +93,12 @@ class CaptureSource {
   // caller's whole-capture scan, such as decode's peak, without a pass of its own).
   explicit CaptureSource(const std::string& path, const CaptureRead& how = {},
                          const std::function<void(std::span<const double>)>& scan = {});
+  // The same with the scan in parts on up to `parts` threads: a WAV's samples are cut into
+  // consecutive runs of whole 65536-sample blocks, part p's run before part p + 1's, and part p
+  // sees its run in order, in the blocks the one-part scan sees (a CSV is one part). An invalid
+  // sample is reported as the one-part pass reports it: the first in the file.
+  using PartScan = std::function<void(std::size_t part, std::span<const double>)>;
+  CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& scan, std::size_t parts);
   ~CaptureSource();
   int channels() const { return channels_; }  // how many the file has
   double file_rate() const { return file_rate_; }  // the rate the file states (0: none)
@@ -116,6 +122,8 @@ class CaptureSource {
   std::size_t first_data_line_ = 0, lineno_ = 0;
   std::ifstream in_;
   std::string buf_;
+  // frames [i0, i0 + m) of the data chunk from `in` (positioned there) into out, through buf
+  void wav_frames(std::ifstream& in, std::string& buf, std::size_t i0, std::size_t m, double* out) const;
 };
 
 }  // namespace ranging

@@ -714,6 +714,13 @@ void FlatTopScan::levels(std::span<const double> x) {
   any_ = true;
 }
 
+void FlatTopScan::merge_levels(const FlatTopScan& later) {
+  if (!later.any_) return;
+  t_.high = any_ ? std::max(t_.high, later.t_.high) : later.t_.high;
+  t_.low = any_ ? std::min(t_.low, later.t_.low) : later.t_.low;
+  any_ = true;
+}
+
 void FlatTopScan::runs(std::span<const double> x) {
   if (!any_ || (t_.high == 0.0 && t_.low == 0.0)) return;
   auto step = [&](std::size_t& run, bool at_level) {

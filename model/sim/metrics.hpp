@@ -153,6 +153,10 @@ class FlatTopScan {
  public:
   explicit FlatTopScan(std::size_t min_run = 3) : min_run_(std::max<std::size_t>(min_run, 1)) {}
   void levels(std::span<const double> x);
+  // levels() of a stream scanned in consecutive parts, each on a scan of its own: this scan's
+  // levels followed by `later`'s part, as if its blocks had come after this scan's (the same
+  // values, signed zeros included: each level is the first of its value in block order).
+  void merge_levels(const FlatTopScan& later);
   void runs(std::span<const double> x);
   FlatTops result() const;
 
