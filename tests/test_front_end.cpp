@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <vector>
@@ -105,6 +106,20 @@ TEST(FrontEnd, AdcCountsWithoutAListAndRefusesAWidthOutOfRange) {
   EXPECT_THROW(adc_quantize(y, a, nullptr), InputError);
   a.bits = 1;
   EXPECT_THROW(adc_quantize(y, a, nullptr), InputError);
+}
+
+// A NaN sample (a broken channel stage) is never a silent code: it sits on the low rail and is
+// counted as clipped, in the eight-at-a-time loop and in the rest.
+TEST(FrontEnd, AdcPutsNaNOnTheLowRailAndCountsIt) {
+  SceneAdc a;
+  a.bits = 12;
+  a.full_scale_v = 2.0;
+  std::vector<double> y(11, std::numeric_limits<double>::quiet_NaN());
+  y[3] = 0.5;
+  std::vector<std::size_t> clipped;
+  EXPECT_EQ(adc_quantize(y, a, &clipped), 10u);
+  EXPECT_EQ(clipped, (std::vector<std::size_t>{0, 1, 2, 4, 5, 6, 7, 8, 9, 10}));
+  for (std::size_t i = 0; i < y.size(); ++i) EXPECT_EQ(y[i], i == 3 ? 0.5 : -2.0) << i;
 }
 
 TEST(FrontEnd, WhiteNoiseIsDeterministicPerSeedAndAddsNothingAtZeroSigma) {
