@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <string>
 
-#include <boost/random/mersenne_twister.hpp>
 #include <boost/random/exponential_distribution.hpp>
 #include <boost/random/normal_distribution.hpp>
 #include <boost/random/uniform_01.hpp>
@@ -35,7 +34,6 @@ constexpr std::uint64_t kMtA = 0xB5026F5AA96619E9ull, kMtUpper = ~std::uint64_t{
 typedef std::uint64_t U8v __attribute__((vector_size(64)));
 typedef double D8v __attribute__((vector_size(64)));
 typedef std::int64_t I8v __attribute__((vector_size(64)));
-typedef I8v L8v;
 
 // The draws in order: buf[pos, len) not yet used; refill() keeps them and appends one twist's
 // 312 outputs. The engine interface (result_type, min, max, operator()) is what Boost's
@@ -208,16 +206,16 @@ std::size_t adc_quantize(std::span<double> x, const SceneAdc& a, std::vector<std
     std::size_t k = 0;
     // Eight samples at a time, each with the scalar loop's operations (the divide, the clamp
     // by blends, truncation to an integer, the exact fraction); the codes fit int32.
-    L8v clip8{};
+    I8v clip8{};
     for (; k + 8 <= m; k += 8) {
       D8v v;
       std::memcpy(&v, xb + k, 64);
       v = (v + a.dc_offset_v) / q;
       v = v > hi ? D8v{} + hi : (v >= lo ? v : D8v{} + lo);
-      const L8v i = __builtin_convertvector(v, L8v);
+      const I8v i = __builtin_convertvector(v, I8v);
       const D8v f = v - __builtin_convertvector(i, D8v);
-      const L8v one = L8v{} + 1, zero{};
-      const L8v rk = i + (f >= 0.5 ? one : zero) - (f <= -0.5 ? one : zero);
+      const I8v one = I8v{} + 1, zero{};
+      const I8v rk = i + (f >= 0.5 ? one : zero) - (f <= -0.5 ? one : zero);
       for (std::size_t u = 0; u < 8; ++u) r[k + u] = static_cast<std::int32_t>(rk[u]);
       clip8 += (rk < -top ? one : zero) + (rk > top - 1 ? one : zero);
     }

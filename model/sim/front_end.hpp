@@ -27,10 +27,13 @@ namespace ranging {
 
 struct SceneAdc;
 
-// x[n] += sigma * N(0, 1), drawn from `seed`; sigma <= 0 adds nothing (no draw).
+// x[n] += sigma * N(0, 1), drawn from `seed`: boost::random::normal_distribution<double>(0, 1)
+// on boost::random::mt19937_64(seed), bit for bit (eight draws at a time); sigma <= 0 adds
+// nothing (no draw).
 void add_white_noise(std::span<double> x, double sigma, std::uint64_t seed);
 
-// The ADC in place (volts in, quantized volts out); returns the number of clipped samples and
+// The ADC in place (volts in, quantized volts out: round half away from zero, the codes
+// clamped to the rails, NaN on the low rail); returns the number of clipped samples and
 // appends their indices to *clipped when it is not null.
 std::size_t adc_quantize(std::span<double> x, const SceneAdc& adc, std::vector<std::size_t>* clipped);
 
