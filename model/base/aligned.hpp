@@ -6,7 +6,6 @@
 #include <cstddef>
 #include <new>
 #include <type_traits>
-#include <utility>
 #include <vector>
 
 namespace ranging {
@@ -46,13 +45,10 @@ struct BufferAllocator : AlignedAllocator<T, 64> {
   BufferAllocator() = default;
   template <class U>
   BufferAllocator(const BufferAllocator<U>&) {}
+  // (only the no-argument form: std::allocator_traits constructs with arguments by itself)
   template <class U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
     ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
 };
 

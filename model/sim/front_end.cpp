@@ -104,13 +104,13 @@ inline Pair ziggurat_pair(std::uint64_t u) {
   return {r * tx[bucket >> 1], bucket >> 1, (bucket & 1) * 2 - 1};
 }
 
-// One unit normal from the draws (Boost's loop), given the first draw's pair that the fast test
-// refused (`p`), or none (the loop from its start).
-[[gnu::noinline]] double unit_normal_slow(Draws& eng, const Pair* refused) {
+// One unit normal from the draws (Boost's loop), its first draw's pair given (`p`: the draw
+// already taken from eng).
+[[gnu::noinline]] double unit_normal_slow(Draws& eng, Pair p) {
   const double* const tx = boost::random::detail::normal_table<double>::table_x;
   const double* const ty = boost::random::detail::normal_table<double>::table_y;
   for (bool first = true;; first = false) {
-    const Pair p = first && refused ? *refused : ziggurat_pair(eng());
+    if (!first) p = ziggurat_pair(eng());
     const int i = p.level, sign = p.sign;
     const double x = p.x;
     if (x < tx[i + 1]) return x * sign;
@@ -176,8 +176,7 @@ void add_white_noise(std::span<double> x, double sigma, std::uint64_t seed) {
       eng.pos += static_cast<std::size_t>(ok);
     }
     // one sample the slow way (its first draw refused by the fast test, or the last < 8)
-    const Pair p = ziggurat_pair(eng());
-    x[i] += sigma * (unit_normal_slow(eng, &p) * 1.0 + 0.0);
+    x[i] += sigma * (unit_normal_slow(eng, ziggurat_pair(eng())) * 1.0 + 0.0);
     ++i;
   }
 }
