@@ -238,6 +238,87 @@ TEST(ReceiverBatch, FloatDetectorGateMatchesAtAnyThresholdAndMinimumEnergy) {
   EXPECT_NE(quiet, base);
 }
 
+// Leading silence: a batch's common leading +0.0 inputs are skipped in steps of P (the batch's
+// silence_step) when the design's silence has a fixed point; the events and every filtered
+// sample must stay the scalar receiver's. Lanes start their echoes at different samples (the
+// skip is the common prefix, not a multiple of P itself), lanes that are silent to their end
+// (one ends exactly where the skip does), -0.0 and a negative gain (x = -0.0: not skipped), and
+// a detector whose gate opens on silence (threshold 0, min_energy 0: no fixed point).
+TEST(ReceiverBatch, FloatSkipsLeadingSilenceWithTheSameResults) {
+  for (const char* family : {"Gold4", "M3"}) {
+    ReceiverConfig cfg;
+    cfg.family = family;
+    fit_decimation_to_chip(cfg);
+    const ReceiverDesign d = design_receiver(cfg);
+    ReceiverFloatBatch probe(d);
+    const std::size_t p = probe.silence_step();
+    if (probe.vectorized()) {
+      EXPECT_GT(p, 0u) << family << ": the default design's silence has a fixed point";
+    }
+    const std::size_t step = p > 0 ? p : 100;
+    const auto base = make_volts(d, 31);
+    // silence before stream s's own samples
+    auto silenced = [&](const std::vector<std::size_t>& quiet, double zero) {
+      std::vector<std::vector<double>> v;
+      for (std::size_t s = 0; s < quiet.size(); ++s) {
+        std::vector<double> x(quiet[s], zero);
+        const auto& b = base[s % base.size()];
+        x.insert(x.end(), b.begin(), b.end());
+        v.push_back(std::move(x));
+      }
+      return v;
+    };
+    const std::vector<std::size_t> late = {9 * step + 37, 7 * step + 1, 12 * step, 9 * step + 99,
+                                           20 * step,     8 * step - 1, 15 * step, 11 * step + 3};
+    // what the batch may skip: the lanes' common leading x = +0.0, down to a multiple of P
+    auto expected = [&](const std::vector<std::vector<double>>& volts, double gain) {
+      std::size_t common = SIZE_MAX;
+      for (const auto& v : volts) {
+        std::size_t i = 0;
+        while (i < v.size() && std::signbit(v[i] * gain) == 0 && v[i] * gain == 0.0) ++i;
+        common = std::min(common, i);
+      }
+      return p > 0 ? common / p * p : 0;
+    };
+    auto run = [&](const std::vector<std::vector<double>>& volts, double gain, const std::string& what) {
+      ReceiverFloatBatch b(d);
+      std::vector<std::span<const double>> spans(volts.begin(), volts.end());
+      std::vector<std::vector<Event>> ev;
+      b.run(spans, gain, ev);
+      expect_float_same(d, volts, gain, std::string(family) + " " + what);
+      return b.silence_skipped();
+    };
+    // every lane silent for 7P - 1 .. 20P (then the stream's own samples): at least 6P skipped
+    const auto late_volts = silenced(late, 0.0);
+    const std::size_t skipped = run(late_volts, kVoltsGain, "late echoes");
+    EXPECT_EQ(skipped, expected(late_volts, kVoltsGain)) << family;
+    if (p > 0) {
+      EXPECT_GE(skipped, 6 * step) << family;
+    }
+    // lanes silent to their end: lengths 3P (ends where the skip does), 3P + 5 and 4P
+    std::vector<std::vector<double>> quiet_lanes = silenced(late, 0.0);
+    quiet_lanes[1].assign(3 * step, 0.0);
+    quiet_lanes[4].assign(3 * step + 5, 0.0);
+    quiet_lanes[6].assign(4 * step, 0.0);
+    EXPECT_EQ(run(quiet_lanes, kVoltsGain, "silent lanes"), p > 0 ? 3 * step : 0) << family;
+    // -0.0 inputs, or +0.0 times a negative gain, are not silence: nothing skipped
+    EXPECT_EQ(run(silenced(late, -0.0), kVoltsGain, "-0.0 prefix"), 0u) << family;
+    EXPECT_EQ(run(silenced(late, 0.0), -kVoltsGain, "negative gain"), 0u) << family;
+  }
+  // a gate that opens on silence (rho^2 = 0 >= 0 and E = 0 >= 0): no fixed point, no skip
+  ReceiverConfig cfg;
+  cfg.detector.threshold = 0.0;
+  cfg.detector.min_energy = 0.0;
+  const ReceiverDesign open = design_receiver(cfg);
+  EXPECT_EQ(ReceiverFloatBatch(open).silence_step(), 0u);
+  std::vector<std::vector<double>> v(3, std::vector<double>(5000, 0.0));
+  const std::vector<double> b = make_volts(open, 5)[0];
+  for (std::size_t s = 0; s < v.size(); ++s) {
+    std::copy(b.begin(), b.begin() + 2000, v[s].begin() + static_cast<std::ptrdiff_t>(3000 - 500 * s));
+  }
+  expect_float_same(open, v, kVoltsGain, "gate open on silence");
+}
+
 // The bank's combiner saturations through the batch: a corr_shift 4 below the automatic one
 // makes the loud streams saturate C_q (the scalar receiver's count is asserted non-zero), and
 // the batch's total per stream must equal the scalar receiver's. (F_q keeps >= 6 dB over a

@@ -1,6 +1,11 @@
 #include "model/dsp/receiver_batch.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cstring>
+#include <cstdint>
+#include <limits>
+#include <numeric>
 
 #include "model/base/error.hpp"
 #include "model/dsp/bank_lanes.hpp"
@@ -23,9 +28,11 @@ constexpr std::size_t kChunk = 1024;  // samples per lane per pass of the kernel
 // for an empty stream), so a lane's counters and its detector's flush are read at its own end.
 // chunk(n0, n, src, open) processes samples [n0, n0 + n): src[l] points at lane l's sample n0,
 // or at `zeros` (>= kChunk of them) for an ended or unused lane, whose results are discarded;
-// open[l] says whether lane l is still running.
+// open[l] says whether lane l is still running. The chunks start at sample `start` (<= every
+// lane's length: the samples before it are the caller's, see ReceiverFloatBatch's silence).
 template <class T, class Chunk, class Finish>
-void run_chunks(std::span<const std::span<const T>> streams, const T* zeros, Chunk&& chunk, Finish&& finish) {
+void run_chunks(std::span<const std::span<const T>> streams, const T* zeros, Chunk&& chunk, Finish&& finish,
+                std::size_t start = 0) {
   const std::size_t lanes = streams.size();
   std::size_t longest = 0;
   bool open[kBatchLanes] = {};
@@ -38,9 +45,9 @@ void run_chunks(std::span<const std::span<const T>> streams, const T* zeros, Chu
     open[l] = true;
   }
   for (std::size_t l = 0; l < lanes; ++l) {
-    if (streams[l].empty()) close(l);
+    if (streams[l].size() <= start) close(l);
   }
-  for (std::size_t n0 = 0, n = 0; n0 < longest; n0 += n) {
+  for (std::size_t n0 = start, n = 0; n0 < longest; n0 += n) {
     n = std::min(kChunk, longest - n0);
     for (std::size_t l = 0; l < lanes; ++l) {
       if (streams[l].size() > n0) n = std::min(n, streams[l].size() - n0);
@@ -157,6 +164,20 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
 // ---- float -----------------------------------------------------------------------------
 
 
+// Silence: the samples of a batch before its first echo, when every lane's x = stream * gain is
+// +0.0 there (its bits: an ideal link's silence), need not run. From reset, silence brings the
+// kernels to a fixed point within P = lcm(period, decimation) samples: every bandpass output
+// +0.0, no detector gate open (the float batch calls an idle lane's detector only at an open
+// gate), every state word +0.0 but the mixer's history, which holds +-0.0 by the LO's signs, in
+// phase with the LO. That is checked once per design, never assumed (Kernels::probe_silence:
+// P samples from reset, then P more must end in the same state bit for bit, with the LO and
+// decimation phases back at reset). Then any m >= 1 runs of P give that state (a ring of +0.0
+// reads the same at any position), so run_lanes skips the largest multiple of P within the
+// lanes' common leading silence: it sets the fixed point, advances the rings' positions as the
+// samples would have, and starts the kernels there. Events, filtered samples (+0.0 in the
+// silence) and the state are those of running every sample, bit for bit
+// (tests/test_receiver_batch.cpp). A design whose silence has no such fixed point, a -0.0 input
+// or a noisy stream skips nothing.
 struct ReceiverFloatBatch::Kernels {
   batch::FloatBandpassBatch bp;
   batch::FloatBankBatch bank;
@@ -195,19 +216,96 @@ struct ReceiverFloatBatch::Kernels {
     arrays.reset(b);  // CorrelatorBankFloat::reset's positions
     b.b_idx = 0;
   }
+
+  std::size_t silence_step = 0;                   // P when silence reaches its fixed point (above), else 0
+  std::vector<LanesF> silent_b_re, silent_b_im;  // the mixer's history there (-0.0 where lo < 0)
+
+  // Whether every word of the state but the mixer's history (b_re, b_im) is +0.0 (all bits 0).
+  bool state_zero() const {
+    const auto zero = [](const void* p, std::size_t bytes) {
+      const auto* c = static_cast<const unsigned char*>(p);
+      return std::all_of(c, c + bytes, [](unsigned char v) { return v == 0; });
+    };
+    const auto rows = [&](const std::vector<LanesF>& v) { return zero(v.data(), v.size() * sizeof(LanesF)); };
+    return zero(bp.x1, sizeof bp.x1) && zero(bp.x2, sizeof bp.x2) && zero(bp.y1, sizeof bp.y1) &&
+           zero(bp.y2, sizeof bp.y2) && zero(&bank.acc_re, sizeof(LanesF)) && zero(&bank.acc_im, sizeof(LanesF)) &&
+           zero(&bank.energy, sizeof(LanesF)) && rows(arrays.y2h) && rows(arrays.bd_re) && rows(arrays.bd_im) &&
+           rows(arrays.f_re) && rows(arrays.f_im) && rows(arrays.q);
+  }
+
+  // p samples of +0.0 through the very kernels run_lanes uses; false when a bandpass output is
+  // not +0.0 or a gate opens.
+  bool run_zeros(std::size_t p, double threshold, double min_energy) {
+    std::vector<LanesF> zin(std::min(p, kChunk)), zout(zin.size());
+    for (std::size_t done = 0; done < p;) {
+      const std::size_t n = std::min(zin.size(), p - done);
+      batch::bandpass_batch_float(bp, zin.data(), zout.data(), n);
+      const bool quiet = std::all_of(zout.begin(), zout.begin() + static_cast<std::ptrdiff_t>(n), [](const LanesF& r) {
+        return std::all_of(std::begin(r.v), std::end(r.v), [](double v) { return std::bit_cast<std::uint64_t>(v) == 0; });
+      });
+      if (!quiet) return false;
+      for (std::size_t i = 0; i < n;) {
+        bool ready = false;
+        i += batch::bank_feed_batch_float(bank, zout.data() + i, n - i, &ready);
+        if (ready && batch::gate_batch_float(bank, threshold, min_energy) != 0) return false;
+      }
+      done += n;
+    }
+    return true;
+  }
+
+  // Sets silence_step (see above): from reset, P zero samples, then P more must give the same
+  // state (the mixer's history bit for bit, the rest +0.0) with quiet outputs and closed gates;
+  // then back to reset.
+  void probe_silence(double threshold, double min_energy) {
+    silence_step = 0;
+    reset();
+    const std::size_t p = static_cast<std::size_t>(std::lcm(bank.period, bank.decimation));
+    const auto same = [](const std::vector<LanesF>& a, const std::vector<LanesF>& b) {
+      return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(LanesF)) == 0;
+    };
+    if (p > 0 && run_zeros(p, threshold, min_energy) && state_zero()) {
+      silent_b_re = arrays.b_re;
+      silent_b_im = arrays.b_im;
+      if (run_zeros(p, threshold, min_energy) && state_zero() && bank.b_idx == 0 && bank.dec_phase == 0 &&
+          same(arrays.b_re, silent_b_re) && same(arrays.b_im, silent_b_im)) {
+        silence_step = p;
+      }
+    }
+    reset();
+  }
+
+  // From reset, the state after s zero samples (a multiple of silence_step, or 0): the mixer's
+  // history at its fixed point, the rings' positions advanced; every other word stays +0.0.
+  void skip_silence(std::size_t s) {
+    if (s == 0) return;
+    auto& b = bank;
+    const std::size_t outputs = s / static_cast<std::size_t>(b.decimation);
+    std::copy(silent_b_re.begin(), silent_b_re.end(), arrays.b_re.begin());
+    std::copy(silent_b_im.begin(), silent_b_im.end(), arrays.b_im.begin());
+    b.y_idx = (b.y_idx + s) % b.window;
+    b.bd_idx = (b.bd_idx + outputs) % b.bd_n;
+    b.f_idx = (b.f_idx + outputs) % b.f_n;
+  }
 };
 
 ReceiverFloatBatch::ReceiverFloatBatch(const ReceiverDesign& design) : design_(design) {
   vectorized_ = batch::batch_kernels_available() && !design.reference.codes.empty() &&
                 static_cast<int>(design.filter.sections.size()) <= batch::kBatchMaxSections;
-  if (vectorized_) k_ = std::make_unique<Kernels>(design_);
+  if (vectorized_) {
+    k_ = std::make_unique<Kernels>(design_);
+    k_->probe_silence(design_.config.detector.threshold, design_.config.detector.min_energy);
+  }
 }
 
 ReceiverFloatBatch::~ReceiverFloatBatch() = default;
 
+std::size_t ReceiverFloatBatch::silence_step() const { return k_ ? k_->silence_step : 0; }
+
 void ReceiverFloatBatch::run(std::span<const std::span<const double>> streams, double gain,
                              std::vector<std::vector<Event>>& events, std::vector<std::vector<double>>* filtered) {
   events.assign(streams.size(), {});
+  skipped_ = 0;
   if (filtered) {
     filtered->resize(streams.size());
     for (std::size_t s = 0; s < streams.size(); ++s) (*filtered)[s].assign(streams[s].size(), 0.0);
@@ -272,7 +370,23 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
   const auto finish = [&](std::size_t l) {
     if (auto e = det[l].flush()) events[l].push_back(*e);
   };
-  run_chunks(streams, k.zeros.data(), chunk, finish);
+  // The lanes' common leading silence (x = +0.0 exactly), skipped in multiples of silence_step.
+  std::size_t start = 0;
+  if (k.silence_step > 0) {
+    std::size_t quiet = std::numeric_limits<std::size_t>::max();
+    for (std::size_t l = 0; l < lanes; ++l) {
+      const std::span<const double> x = streams[l];
+      std::size_t i = 0;
+      const std::size_t lim = std::min(quiet, x.size());
+      while (i < lim && std::bit_cast<std::uint64_t>(x[i] * gain) == 0) ++i;
+      quiet = i;
+    }
+    if (lanes == 0) quiet = 0;
+    start = quiet / k.silence_step * k.silence_step;
+    k.skip_silence(start);
+    skipped_ += start;
+  }
+  run_chunks(streams, k.zeros.data(), chunk, finish, start);
 }
 
 }  // namespace ranging

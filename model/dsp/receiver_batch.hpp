@@ -58,7 +58,9 @@ class ReceiverFixedBatch {
 // ReceiverFloatBatch: ReceiverFloat on up to kLanes streams at once, the same way (IEEE double
 // per lane in ReceiverFloat's order of operations, so each stream's events and filtered
 // samples are ReceiverFloat's bit for bit; the scalar receiver per stream where the kernels
-// cannot run).
+// cannot run). A batch's common leading silence (inputs of +0.0, an ideal link's samples before
+// the echo) is not run when the design's silence has a checked fixed point: the kernels start
+// from that state instead, with the same results (receiver_batch.cpp, "Silence").
 class ReceiverFloatBatch {
  public:
   static constexpr std::size_t kLanes = 8;
@@ -76,11 +78,17 @@ class ReceiverFloatBatch {
            std::vector<std::vector<double>>* filtered = nullptr);
 
   bool vectorized() const { return vectorized_; }
+  // Leading silence (receiver_batch.cpp): the step P in which a batch's common leading +0.0
+  // inputs are skipped (0: this design's silence has no fixed point, or not vectorized), and
+  // the samples per lane the last run() skipped, summed over its batches.
+  std::size_t silence_step() const;
+  std::size_t silence_skipped() const { return skipped_; }
 
  private:
   struct Kernels;
   ReceiverDesign design_;
   bool vectorized_ = false;
+  std::size_t skipped_ = 0;
   std::unique_ptr<Kernels> k_;
   void run_lanes(std::span<const std::span<const double>> streams, double gain, std::vector<Event>* events,
                  std::vector<double>* filtered);
