@@ -138,6 +138,80 @@ TEST(ReceiverBatch, MatchesInEveryRoundingAndOverflowModeAndBothMultiplyWidths) 
   EXPECT_GE(overflowed, 4u);
 }
 
+// Leading silence at fixed precision: a batch's common leading codes of 0 are skipped in steps
+// of P when the design allows it (every rounding mode: 0 rounds to 0), with the scalar
+// receiver's events and overflow counts; lanes silent to their end (one ends where the skip
+// does); a gate that opens on silence (threshold 0, min_energy 0) skips nothing.
+TEST(ReceiverBatch, FixedSkipsLeadingSilenceWithTheSameResults) {
+  const Rounding modes[] = {Rounding::RoundHalfUp, Rounding::Truncate, Rounding::Convergent};
+  for (const char* family : {"Gold4", "M3"}) {
+    for (Rounding r : modes) {
+      ReceiverConfig cfg;
+      cfg.family = family;
+      cfg.bandpass.rounding = r;
+      fit_decimation_to_chip(cfg);
+      const ReceiverDesign d = design_receiver(cfg);
+      const std::size_t p = ReceiverFixedBatch(d).silence_step();
+      if (ReceiverFixedBatch(d).vectorized()) {
+        EXPECT_GT(p, 0u) << family << ": silence stays at reset";
+      }
+      const std::size_t step = p > 0 ? p : 100;
+      const auto base = make_streams(d, {9000, 12000, 0, 7000, 15000, 9000, 11000, 8000, 6000}, 41);
+      const std::vector<std::size_t> late = {9 * step + 37, 7 * step + 1, 12 * step, 9 * step + 99, 20 * step,
+                                             8 * step - 1,  15 * step,    11 * step + 3, 10 * step};
+      std::vector<std::vector<std::int64_t>> streams;
+      for (std::size_t s = 0; s < base.size(); ++s) {
+        std::vector<std::int64_t> x(late[s], 0);
+        x.insert(x.end(), base[s].begin(), base[s].end());
+        streams.push_back(std::move(x));
+      }
+      auto run = [&](const std::vector<std::vector<std::int64_t>>& st, const std::string& what) {
+        expect_same(d, st, what.c_str());
+        ReceiverFixedBatch b(d);
+        std::vector<std::span<const std::int64_t>> spans(st.begin(), st.end());
+        std::vector<std::vector<EventFixed>> ev;
+        std::vector<OverflowCounter> ovf;
+        b.run(spans, ev, ovf);
+        return b.silence_skipped();
+      };
+      // what may be skipped: each batch of 8 lanes' common leading zeros, down to a multiple of P
+      auto expected = [&](const std::vector<std::vector<std::int64_t>>& st) {
+        std::size_t want = 0;
+        for (std::size_t s0 = 0; s0 < st.size(); s0 += 8) {
+          std::size_t common = SIZE_MAX;
+          for (std::size_t s = s0; s < std::min(st.size(), s0 + 8); ++s) {
+            std::size_t i = 0;
+            while (i < st[s].size() && st[s][i] == 0) ++i;
+            common = std::min(common, i);
+          }
+          want += p > 0 ? common / p * p : 0;
+        }
+        return want;
+      };
+      const std::size_t skipped = run(streams, std::string(family) + " late echoes");
+      EXPECT_EQ(skipped, expected(streams)) << family;
+      if (p > 0) {
+        EXPECT_GE(skipped, 6 * step + 9 * step) << family << ": both batches skip";
+      }
+      streams[1].assign(3 * step, 0);
+      streams[4].assign(3 * step + 5, 0);
+      EXPECT_EQ(run(streams, std::string(family) + " silent lanes"), expected(streams)) << family;
+      // a code of -1 ends the silence as any other non-zero code
+      std::vector<std::vector<std::int64_t>> blip(8, std::vector<std::int64_t>(5 * step - 1, 0));
+      for (auto& x : blip) {
+        x.push_back(-1);
+        x.insert(x.end(), 2 * step, 0);
+        x.insert(x.end(), base[0].begin(), base[0].end());
+      }
+      EXPECT_EQ(run(blip, std::string(family) + " -1 after 5P - 1 zeros"), p > 0 ? 4 * step : 0) << family;
+    }
+  }
+  ReceiverConfig cfg;
+  cfg.detector.threshold = 0.0;
+  cfg.detector.min_energy = 0.0;
+  EXPECT_EQ(ReceiverFixedBatch(design_receiver(cfg)).silence_step(), 0u);
+}
+
 TEST(ReceiverBatch, RefusesAnOutOfRangeCodeAsTheScalarReceiverDoes) {
   ReceiverConfig cfg;
   const ReceiverDesign d = design_receiver(cfg);

@@ -62,6 +62,40 @@ void run_chunks(std::span<const std::span<const T>> streams, const T* zeros, Chu
     }
   }
 }
+// Whether `bytes` bytes at p are all zero (a state of +0.0 / 0 words).
+bool zero_bits(const void* p, std::size_t bytes) {
+  const auto* c = static_cast<const unsigned char*>(p);
+  return std::all_of(c, c + bytes, [](unsigned char v) { return v == 0; });
+}
+template <class Row>
+bool zero_rows(const std::vector<Row>& v) {
+  return zero_bits(v.data(), v.size() * sizeof(Row));
+}
+
+// The lanes' common leading silence (silent(x) on each lane's samples from its first), rounded
+// down to a multiple of step (step 0: none).
+template <class T, class Silent>
+std::size_t common_silence(std::span<const std::span<const T>> streams, std::size_t step, Silent&& silent) {
+  if (step == 0 || streams.empty()) return 0;
+  std::size_t quiet = std::numeric_limits<std::size_t>::max();
+  for (const auto& x : streams) {
+    std::size_t i = 0;
+    const std::size_t lim = std::min(quiet, x.size());
+    while (i < lim && silent(x[i])) ++i;
+    quiet = i;
+  }
+  return quiet / step * step;
+}
+
+// A bank's rings (energy window, Bd, F) moved on by s samples (a multiple of the decimation) as
+// the samples would have moved them; the LO and decimation phases are the caller's.
+template <class Bank>
+void advance_rings(Bank& b, std::size_t s) {
+  const std::size_t outputs = s / static_cast<std::size_t>(b.decimation);
+  b.y_idx = (b.y_idx + s) % b.window;
+  b.bd_idx = (b.bd_idx + outputs) % b.bd_n;
+  b.f_idx = (b.f_idx + outputs) % b.f_n;
+}
 }  // namespace
 
 // The kernels' state: the bandpass lanes and the bank's (bank_lanes.hpp).
@@ -88,20 +122,66 @@ struct ReceiverFixedBatch::Kernels {
     lanes.reset();
     for (int l = 0; l < kBatchLanes; ++l) bp_events[l] = {};
   }
+
+  // Silence (as ReceiverFloatBatch's, below, with integers: no signed zeros, so the fixed point
+  // is the reset state itself): P = lcm(period, decimation) codes of 0 from reset must give
+  // outputs of 0, no overflow, Q_j = 0 and E = 0 at every decimated output with the detector's
+  // gate closed there (threshold_q > 0 or min_norm_q > 0: the fixed batch calls every lane's
+  // detector, which then changes nothing), and end with every state word 0 and the phases back
+  // at reset. silence_step = P then, else 0.
+  std::size_t silence_step = 0;
+  void probe_silence(const PeakDetectorFixed& det) {
+    silence_step = 0;
+    reset();
+    const std::size_t p = static_cast<std::size_t>(std::lcm(bank.period, bank.decimation));
+    const auto codes = static_cast<std::size_t>(bank.codes);
+    bool ok = p > 0 && (det.threshold_q() > 0 || det.min_norm_q() > 0);
+    std::vector<Lanes> zin(std::min(p, kChunk)), zout(zin.size());
+    for (std::size_t done = 0; ok && done < p;) {
+      const std::size_t n = std::min(zin.size(), p - done);
+      batch::bandpass_batch(bp, zin.data(), zout.data(), n);
+      ok = zero_bits(zout.data(), n * sizeof(Lanes));
+      for (std::size_t i = 0; ok && i < n;) {
+        bool ready = false;
+        i += batch::bank_feed_batch(bank, zout.data() + i, n - i, &ready);
+        if (ready) ok = zero_bits(bank.q, codes * sizeof(Lanes)) && zero_bits(&bank.energy, sizeof(Lanes));
+      }
+      done += n;
+    }
+    for (int l = 0; ok && l < kBatchLanes; ++l) {
+      ok = bp_events[l].total() == 0 && lanes.mix_events[l].total() == 0 && lanes.chip_events[l].total() == 0 &&
+           lanes.corr_events[l].total() == 0;
+    }
+    const auto& a = lanes.arrays;
+    if (ok && bank.phase == 0 && bank.dec_phase == 0 && zero_bits(&bp.x1, sizeof bp.x1) &&
+        zero_bits(&bp.x2, sizeof bp.x2) && zero_bits(bp.y1, sizeof bp.y1) && zero_bits(bp.y2, sizeof bp.y2) &&
+        zero_bits(&bank.acc_re, sizeof(Lanes)) && zero_bits(&bank.acc_im, sizeof(Lanes)) &&
+        zero_bits(&bank.energy, sizeof(Lanes)) && zero_rows(a.b_re) && zero_rows(a.b_im) && zero_rows(a.y2h) &&
+        zero_rows(a.bd_re) && zero_rows(a.bd_im) && zero_rows(a.f_re) && zero_rows(a.f_im) && zero_rows(a.q)) {
+      silence_step = p;
+    }
+    reset();
+  }
 };
 
 ReceiverFixedBatch::ReceiverFixedBatch(const ReceiverDesign& design)
     : design_(design), frac_bits_(design.config.detector.frac_bits), score_bits_(design.config.correlator.score_bits) {
   vectorized_ = batch::batch_kernels_available() &&
                 static_cast<int>(design.filter.sections.size()) <= batch::kBatchMaxSections;
-  if (vectorized_) k_ = std::make_unique<Kernels>(design_);
+  if (vectorized_) {
+    k_ = std::make_unique<Kernels>(design_);
+    k_->probe_silence(PeakDetectorFixed(design_.config.detector, design_.layout, design_.config.correlator));
+  }
 }
 
 ReceiverFixedBatch::~ReceiverFixedBatch() = default;
 
+std::size_t ReceiverFixedBatch::silence_step() const { return k_ ? k_->silence_step : 0; }
+
 void ReceiverFixedBatch::run(std::span<const std::span<const std::int64_t>> streams,
                              std::vector<std::vector<EventFixed>>& events, std::vector<OverflowCounter>& overflows) {
   events.assign(streams.size(), {});
+  skipped_ = 0;
   overflows.assign(streams.size(), {});
   for (std::size_t s0 = 0; s0 < streams.size(); s0 += kLanes) {
     const std::size_t n = std::min(kLanes, streams.size() - s0);
@@ -158,7 +238,11 @@ void ReceiverFixedBatch::run_lanes(std::span<const std::span<const std::int64_t>
     if (auto e = det[l].flush()) events[l].push_back(*e);
     overflows[l] = k.bp_events[l] + k.lanes.mix_events[l] + k.lanes.chip_events[l] + k.lanes.corr_events[l];
   };
-  run_chunks(streams, k.zeros.data(), chunk, finish);
+  // The lanes' common leading codes of 0, skipped in multiples of silence_step (Kernels).
+  const std::size_t start = common_silence(streams, k.silence_step, [](std::int64_t c) { return c == 0; });
+  advance_rings(k.bank, start);
+  skipped_ += start;
+  run_chunks(streams, k.zeros.data(), chunk, finish, start);
 }
 
 // ---- float -----------------------------------------------------------------------------
@@ -222,15 +306,11 @@ struct ReceiverFloatBatch::Kernels {
 
   // Whether every word of the state but the mixer's history (b_re, b_im) is +0.0 (all bits 0).
   bool state_zero() const {
-    const auto zero = [](const void* p, std::size_t bytes) {
-      const auto* c = static_cast<const unsigned char*>(p);
-      return std::all_of(c, c + bytes, [](unsigned char v) { return v == 0; });
-    };
-    const auto rows = [&](const std::vector<LanesF>& v) { return zero(v.data(), v.size() * sizeof(LanesF)); };
-    return zero(bp.x1, sizeof bp.x1) && zero(bp.x2, sizeof bp.x2) && zero(bp.y1, sizeof bp.y1) &&
-           zero(bp.y2, sizeof bp.y2) && zero(&bank.acc_re, sizeof(LanesF)) && zero(&bank.acc_im, sizeof(LanesF)) &&
-           zero(&bank.energy, sizeof(LanesF)) && rows(arrays.y2h) && rows(arrays.bd_re) && rows(arrays.bd_im) &&
-           rows(arrays.f_re) && rows(arrays.f_im) && rows(arrays.q);
+    return zero_bits(bp.x1, sizeof bp.x1) && zero_bits(bp.x2, sizeof bp.x2) && zero_bits(bp.y1, sizeof bp.y1) &&
+           zero_bits(bp.y2, sizeof bp.y2) && zero_bits(&bank.acc_re, sizeof(LanesF)) &&
+           zero_bits(&bank.acc_im, sizeof(LanesF)) && zero_bits(&bank.energy, sizeof(LanesF)) &&
+           zero_rows(arrays.y2h) && zero_rows(arrays.bd_re) && zero_rows(arrays.bd_im) && zero_rows(arrays.f_re) &&
+           zero_rows(arrays.f_im) && zero_rows(arrays.q);
   }
 
   // p samples of +0.0 through the very kernels run_lanes uses; false when a bandpass output is
@@ -279,13 +359,9 @@ struct ReceiverFloatBatch::Kernels {
   // history at its fixed point, the rings' positions advanced; every other word stays +0.0.
   void skip_silence(std::size_t s) {
     if (s == 0) return;
-    auto& b = bank;
-    const std::size_t outputs = s / static_cast<std::size_t>(b.decimation);
     std::copy(silent_b_re.begin(), silent_b_re.end(), arrays.b_re.begin());
     std::copy(silent_b_im.begin(), silent_b_im.end(), arrays.b_im.begin());
-    b.y_idx = (b.y_idx + s) % b.window;
-    b.bd_idx = (b.bd_idx + outputs) % b.bd_n;
-    b.f_idx = (b.f_idx + outputs) % b.f_n;
+    advance_rings(bank, s);
   }
 };
 
@@ -371,21 +447,10 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
     if (auto e = det[l].flush()) events[l].push_back(*e);
   };
   // The lanes' common leading silence (x = +0.0 exactly), skipped in multiples of silence_step.
-  std::size_t start = 0;
-  if (k.silence_step > 0) {
-    std::size_t quiet = std::numeric_limits<std::size_t>::max();
-    for (std::size_t l = 0; l < lanes; ++l) {
-      const std::span<const double> x = streams[l];
-      std::size_t i = 0;
-      const std::size_t lim = std::min(quiet, x.size());
-      while (i < lim && std::bit_cast<std::uint64_t>(x[i] * gain) == 0) ++i;
-      quiet = i;
-    }
-    if (lanes == 0) quiet = 0;
-    start = quiet / k.silence_step * k.silence_step;
-    k.skip_silence(start);
-    skipped_ += start;
-  }
+  const std::size_t start = common_silence(
+      streams, k.silence_step, [gain](double x) { return std::bit_cast<std::uint64_t>(x * gain) == 0; });
+  k.skip_silence(start);
+  skipped_ += start;
   run_chunks(streams, k.zeros.data(), chunk, finish, start);
 }
 

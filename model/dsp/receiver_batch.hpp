@@ -9,6 +9,9 @@
 // differ in length: the lanes run in lockstep to the longest; a lane that has ended is fed
 // zeros whose results are discarded (its detector is flushed and its counters are read at its
 // own last sample), so a batch of streams of similar length wastes little.
+// A batch's common leading silence (codes of 0: an ideal link before the echo) is not run when
+// the design's silence leaves the receiver at reset, which is checked once per design; the
+// kernels start after it with the same results (receiver_batch.cpp, "Silence").
 //
 // Where the work is: the bandpass cascade and the bank's full-rate front end and decimated
 // outputs run in receiver_batch_kernels_v4.cpp (AVX-512, 8 lanes of int64), and so does the
@@ -44,12 +47,18 @@ class ReceiverFixedBatch {
 
   bool vectorized() const { return vectorized_; }
   Event to_float(const EventFixed& e) const { return e.to_float(frac_bits_, score_bits_); }
+  // Leading silence (receiver_batch.cpp): the step P in which a batch's common leading codes of
+  // 0 are skipped (0: not for this design, or not vectorized), and the samples per lane the
+  // last run() skipped, summed over its batches.
+  std::size_t silence_step() const;
+  std::size_t silence_skipped() const { return skipped_; }
 
  private:
   struct Kernels;  // the SIMD state (receiver_batch.cpp)
   ReceiverDesign design_;
   int frac_bits_, score_bits_;
   bool vectorized_ = false;
+  std::size_t skipped_ = 0;
   std::unique_ptr<Kernels> k_;
   void run_lanes(std::span<const std::span<const std::int64_t>> streams, std::vector<EventFixed>* events,
                  OverflowCounter* overflows);
