@@ -142,6 +142,69 @@ TEST(FastQuantizer, AdcQuantizerMatchesTheWideReferenceAtTiesEdgesAndBeyondFullS
   EXPECT_THROW(quantize_input(std::numeric_limits<double>::infinity(), 12, nullptr), InputError);
 }
 
+// quantize_input_block (eight samples at a time) against the loop it replaces: codes, the
+// saturation count and the clamped indices, at the ties, +-1 and beyond, -0.0, tiny values,
+// for every word length of both paths, several gains (one negative) and lengths around the
+// vector width, infinities (clamped to +-1 first, as the loop does); a NaN throws at the loop's
+// sample with the codes before it written.
+TEST(FastQuantizer, BlockQuantizerIsTheLoopBitForBit) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1.3, 1.3);
+  std::uniform_int_distribution<int> e(-1080, 2);
+  std::size_t compared = 0, saturated = 0, clamps = 0;
+  for (int bits : {2, 3, 12, 16, 24, 40, 41, 52}) {
+    const double lsb = std::ldexp(1.0, -(bits - 1));
+    std::vector<double> base = {0.0, -0.0, 1.0, -1.0, std::nextafter(1.0, 2.0), std::nextafter(-1.0, -2.0),
+                                1.0 - 0.5 * lsb, std::nextafter(1.0 - 0.5 * lsb, 0.0), 5e-324, -5e-324,
+                                std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    for (int k = -20; k <= 20; ++k) {
+      const double t = (k + 0.5) * lsb;
+      for (double v : {t, std::nextafter(t, 1.0), std::nextafter(t, -1.0), k * lsb}) base.push_back(v);
+    }
+    for (int i = 0; i < 4000; ++i) base.push_back(i % 3 ? u(rng) : std::ldexp(u(rng), e(rng)));
+    std::shuffle(base.begin(), base.end(), rng);
+    for (double gain : {1.0, 1.0 / (0.037 * 2048.0), -0.7, 3.0}) {
+      for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{7}, std::size_t{8}, std::size_t{9},
+                            std::size_t{63}, std::size_t{64}, std::size_t{1001}, base.size()}) {
+        const std::span<const double> x(base.data(), n);
+        std::vector<std::int64_t> want(n), got(n);
+        OverflowCounter cw, cg;
+        std::vector<std::size_t> lw, lg;
+        for (std::size_t i = 0; i < n; ++i) {
+          const double v = x[i] * gain;
+          if (std::abs(v) > 1.0) lw.push_back(100 + i);
+          want[i] = quantize_input(std::clamp(v, -1.0, 1.0), bits, &cw);
+        }
+        quantize_input_block(x, gain, bits, got.data(), cg, &lg, 100);
+        ASSERT_EQ(got, want) << "bits " << bits << " gain " << gain << " n " << n;
+        EXPECT_EQ(cg.saturations, cw.saturations) << "bits " << bits << " gain " << gain << " n " << n;
+        EXPECT_EQ(cg.wraps, 0u);
+        EXPECT_EQ(lg, lw) << "bits " << bits << " gain " << gain << " n " << n;
+        OverflowCounter c3;
+        quantize_input_block(x, gain, bits, got.data(), c3, nullptr);  // no list: the same codes
+        EXPECT_EQ(got, want);
+        compared += n;
+        saturated += cw.saturations;
+        clamps += lw.size();
+      }
+    }
+  }
+  EXPECT_GT(compared, 100000u);
+  EXPECT_GT(saturated, 0u);
+  EXPECT_GT(clamps, 0u);
+  // a NaN: InputError at that sample, the codes before it written
+  for (double bad : {std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::quiet_NaN()}) {
+    for (std::size_t at : {std::size_t{0}, std::size_t{5}, std::size_t{8}, std::size_t{21}}) {
+      std::vector<double> x(32, 0.25);
+      x[at] = bad;
+      std::vector<std::int64_t> got(32, -7);
+      OverflowCounter c;
+      EXPECT_THROW(quantize_input_block(x, 1.0, 12, got.data(), c, nullptr), InputError);
+      for (std::size_t i = 0; i < at; ++i) EXPECT_EQ(got[i], 512) << "sample " << i << " before the bad one at " << at;
+    }
+  }
+}
+
 TEST(FastQuantizer, RoundHalfAwayIsStdRoundBitForBit) {
   std::vector<double> xs = {0.0, -0.0, 0.5, -0.5, 1.5, -1.5, 2.5, -2.5, 0.49999999999999994, -0.49999999999999994,
                             4503599627370495.5, -4503599627370495.5, 4503599627370496.0, 9007199254740993.0, 1e300,

@@ -13,6 +13,8 @@
 // saturation counted in *counter (when not null). InputError when x is not finite.
 #include <cmath>
 #include <cstdint>
+#include <span>
+#include <vector>
 #include <string>
 
 #include "model/dsp/fixed_point.hpp"
@@ -32,6 +34,17 @@ inline double round_half_away(double v) {
   const double r = static_cast<double>(i + (frac >= 0.5) - (frac <= -0.5));
   return r == 0.0 ? std::copysign(0.0, v) : r;  // std::round keeps the sign of a zero
 }
+// quantize_input on a block, as the receivers' callers quantize their input: out[i] =
+// quantize_input(clamp(x[i] * gain, -1, 1), bits, &counter), and index0 + i appended to
+// *clamped (when not null) where |x[i] * gain| > 1, in order. The same values, counts and
+// list as that loop, bit for bit (tests/test_block_api.cpp); a NaN x[i] * gain throws
+// quantize_input's InputError with out[0, i) written, as the loop does (an infinity is clamped). Eight samples at a time
+// (an AVX-512 clone where the CPU has it): the product, floor(v 2^(bits-1+20)) by truncation
+// and an exact correction, the int64 path's rounding and saturation; eight with a sample beyond
+// +-1 or not finite, and any bits outside 2..40, run the loop itself.
+void quantize_input_block(std::span<const double> x, double gain, int bits, std::int64_t* out,
+                          OverflowCounter& counter, std::vector<std::size_t>* clamped, std::size_t index0 = 0);
+
 // The same function through a 128-bit intermediate for every argument (the reference that
 // quantize_input's int64 path is tested against: tests/test_quantize.cpp).
 std::int64_t quantize_input_wide(double x, int bits, OverflowCounter* counter);

@@ -328,10 +328,7 @@ struct SceneSimulator::Link {
   // quantizes them, into q[0, n1 - n0); appends the indices the clamp to +-scale cut to *clamped.
   static void quantize_codes(std::span<const double> volts, std::size_t n0, std::size_t n1, double inv, int bits,
                              std::int64_t* q, OverflowCounter& adc, std::vector<std::size_t>* clamped) {
-    for (std::size_t n = n0; n < n1; ++n) {
-      if (clamped && std::abs(volts[n] * inv) > 1.0) clamped->push_back(n);
-      q[n - n0] = quantize_input(std::clamp(volts[n] * inv, -1.0, 1.0), bits, &adc);
-    }
+    quantize_input_block(volts.subspan(n0, n1 - n0), inv, bits, q, adc, clamped, n0);
   }
 
   // One stream of receive_batch: its input, and what receive() gives for it.
