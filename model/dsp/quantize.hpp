@@ -38,10 +38,11 @@ inline double round_half_away(double v) {
 // quantize_input(clamp(x[i] * gain, -1, 1), bits, &counter), and index0 + i appended to
 // *clamped (when not null) where |x[i] * gain| > 1, in order. The same values, counts and
 // list as that loop, bit for bit (tests/test_block_api.cpp); a NaN x[i] * gain throws
-// quantize_input's InputError with out[0, i) written, as the loop does (an infinity is clamped). Eight samples at a time
-// (an AVX-512 clone where the CPU has it): the product, floor(v 2^(bits-1+20)) by truncation
-// and an exact correction, the int64 path's rounding and saturation; eight with a sample beyond
-// +-1 or not finite, and any bits outside 2..40, run the loop itself.
+// quantize_input's InputError with out[0, i) written, as the loop does (an infinity is
+// clamped). On a CPU with AVX-512 (F, DQ), eight samples at a time: the product,
+// floor(v 2^(bits-1+20)) in one conversion rounding down, the int64 path's rounding and
+// saturation; a group of eight with a sample beyond +-1 or NaN, a CPU without AVX-512 and any
+// bits outside 2..40 run the loop itself.
 void quantize_input_block(std::span<const double> x, double gain, int bits, std::int64_t* out,
                           OverflowCounter& counter, std::vector<std::size_t>* clamped, std::size_t index0 = 0);
 
