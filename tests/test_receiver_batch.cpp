@@ -393,6 +393,35 @@ TEST(ReceiverBatch, FloatSkipsLeadingSilenceWithTheSameResults) {
   expect_float_same(open, v, kVoltsGain, "gate open on silence");
 }
 
+// bandpass_float_streams (the metrics' float filter on the SIMD lanes) against a fresh
+// BandpassFloat per stream, bit for bit: 11 streams of mixed lengths (empty, shorter than a
+// vector, around the chunk), cascades of 1, 3 and 5 sections and one of 9 (the scalar path).
+TEST(ReceiverBatch, FloatBandpassOnTheLanesIsBandpassFloatPerStream) {
+  const ReceiverDesign d = design_receiver(ReceiverConfig{});
+  auto volts = make_volts(d, 23);
+  volts[4].assign(1023, 0.0);
+  for (std::size_t i = 0; i < volts[4].size(); ++i) volts[4][i] = std::sin(0.25 * static_cast<double>(i));
+  volts.push_back(std::vector<double>(1025, -0.0));
+  std::vector<std::span<const double>> spans(volts.begin(), volts.end());
+  for (std::size_t k : {std::size_t{1}, std::size_t{3}, std::size_t{5}, std::size_t{9}}) {
+    SosFilter f = d.filter;
+    f.sections.clear();
+    for (std::size_t i = 0; i < k; ++i) f.sections.push_back(d.filter.sections[i % d.filter.sections.size()]);
+    std::vector<std::vector<double>> got;
+    bandpass_float_streams(f, spans, got);
+    ASSERT_EQ(got.size(), volts.size());
+    for (std::size_t s = 0; s < volts.size(); ++s) {
+      std::vector<double> want(volts[s].size());
+      BandpassFloat(f).execute_block(volts[s], want);
+      ASSERT_EQ(got[s].size(), want.size()) << k << " sections, stream " << s;
+      if (!want.empty()) {
+        EXPECT_EQ(std::memcmp(got[s].data(), want.data(), want.size() * sizeof(double)), 0)
+            << k << " sections, stream " << s << " (" << want.size() << " samples)";
+      }
+    }
+  }
+}
+
 // The bank's combiner saturations through the batch: a corr_shift 4 below the automatic one
 // makes the loud streams saturate C_q (the scalar receiver's count is asserted non-zero), and
 // the batch's total per stream must equal the scalar receiver's. (F_q keeps >= 6 dB over a

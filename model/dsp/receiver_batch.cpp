@@ -454,4 +454,31 @@ void ReceiverFloatBatch::run_lanes(std::span<const std::span<const double>> stre
   run_chunks(streams, k.zeros.data(), chunk, finish, start);
 }
 
+void bandpass_float_streams(const SosFilter& filter, std::span<const std::span<const double>> streams,
+                            std::vector<std::vector<double>>& out) {
+  out.resize(streams.size());
+  for (std::size_t s = 0; s < streams.size(); ++s) out[s].resize(streams[s].size());
+  if (!batch::batch_kernels_available() || filter.sections.empty() ||
+      static_cast<int>(filter.sections.size()) > batch::kBatchMaxSections) {
+    for (std::size_t s = 0; s < streams.size(); ++s) BandpassFloat(filter).execute_block(streams[s], out[s]);
+    return;
+  }
+  std::vector<LanesF> in(kChunk), res(kChunk);
+  std::vector<double> zeros(kChunk), discard(kChunk);
+  for (std::size_t s0 = 0; s0 < streams.size(); s0 += kBatchLanes) {
+    const auto group = streams.subspan(s0, std::min<std::size_t>(kBatchLanes, streams.size() - s0));
+    batch::FloatBandpassBatch bp = bandpass_batch_constants(filter.sections);  // every lane at reset
+    const auto chunk = [&](std::size_t n0, std::size_t n, const double* const* src, const bool* open) {
+      batch::interleave_batch_float(src, 1.0, in.data(), n);  // x * 1.0 == x, bit for bit
+      batch::bandpass_batch_float(bp, in.data(), res.data(), n);
+      double* dst[kBatchLanes];
+      for (std::size_t l = 0; l < static_cast<std::size_t>(kBatchLanes); ++l) {
+        dst[l] = l < group.size() && open[l] ? out[s0 + l].data() + n0 : discard.data();
+      }
+      batch::deinterleave_batch_float(res.data(), dst, n);
+    };
+    run_chunks(group, static_cast<const double*>(zeros.data()), chunk, [](std::size_t) {});
+  }
+}
+
 }  // namespace ranging

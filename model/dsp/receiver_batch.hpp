@@ -103,4 +103,11 @@ class ReceiverFloatBatch {
                  std::vector<double>* filtered);
 };
 
+// BandpassFloat (a fresh one per stream) on any number of streams, kLanes at a time on the
+// SIMD lanes (the float batch's bandpass kernel): out[s] = what BandpassFloat(filter)
+// .execute_block gives for streams[s], bit for bit (tests/test_receiver_batch.cpp); the
+// scalar filter per stream where the kernels cannot run. out is resized to the streams.
+void bandpass_float_streams(const SosFilter& filter, std::span<const std::span<const double>> streams,
+                            std::vector<std::vector<double>>& out);
+
 }  // namespace ranging

@@ -381,13 +381,16 @@ struct SceneSimulator::Link {
     std::vector<std::vector<EventFixed>> raw;
     std::vector<OverflowCounter> ovf;
     batch.run(spans, raw, ovf);
+    // the float filter runs for the metrics only (else empty), on the streams' SIMD lanes
+    std::vector<std::vector<double>> f;
+    if (scene->receiver.metrics.any()) {
+      std::vector<std::span<const double>> vs;
+      for (const auto& st : streams) vs.emplace_back(*st.volts);
+      bandpass_float_streams(design.filter, vs, f);
+    }
     for (std::size_t i = 0; i < streams.size(); ++i) {
       auto& st = streams[i];
-      if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only (else empty)
-        st.filtered.assign(st.volts->size(), 0.0);
-        BandpassFloat bp(design.filter);
-        bp.execute_block(std::span<const double>(*st.volts), std::span<double>(st.filtered));
-      }
+      if (!f.empty()) st.filtered = std::move(f[i]);
       st.events.clear();
       for (const auto& e : raw[i]) st.events.push_back(batch.to_float(e));
       st.overflows = ovf[i].total() + adc[i].total();
