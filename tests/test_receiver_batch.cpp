@@ -53,6 +53,15 @@ std::vector<std::vector<std::int64_t>> make_streams(const ReceiverDesign& d, con
   return out;
 }
 
+// The default receiver for a family (its decimation fitted to the chip), bandpass rounding r.
+ReceiverDesign family_design(const char* family, Rounding r = ReceiverConfig{}.bandpass.rounding) {
+  ReceiverConfig cfg;
+  cfg.family = family;
+  cfg.bandpass.rounding = r;
+  fit_decimation_to_chip(cfg);
+  return design_receiver(cfg);
+}
+
 // 11 streams: two batches, the second partial; lengths around a decimated output's end (D).
 std::vector<std::size_t> mixed_lengths(const ReceiverDesign& d) {
   const auto dec = static_cast<std::size_t>(d.layout.decimation);
@@ -90,10 +99,7 @@ std::uint64_t expect_same(const ReceiverDesign& d, const std::vector<std::vector
 
 TEST(ReceiverBatch, MatchesTheScalarReceiverPerStreamOfAnyLength) {
   for (const char* family : {"Gold4", "M3"}) {
-    ReceiverConfig cfg;
-    cfg.family = family;
-    fit_decimation_to_chip(cfg);
-    const ReceiverDesign d = design_receiver(cfg);
+    const ReceiverDesign d = family_design(family);
     const auto streams = make_streams(d, mixed_lengths(d), 11);
     const std::uint64_t ovf = expect_same(d, streams, family);
     std::printf("[ receiver batch ] %s: %s path, %llu overflow events compared\n", family,
@@ -146,11 +152,7 @@ TEST(ReceiverBatch, FixedSkipsLeadingSilenceWithTheSameResults) {
   const Rounding modes[] = {Rounding::RoundHalfUp, Rounding::Truncate, Rounding::Convergent};
   for (const char* family : {"Gold4", "M3"}) {
     for (Rounding r : modes) {
-      ReceiverConfig cfg;
-      cfg.family = family;
-      cfg.bandpass.rounding = r;
-      fit_decimation_to_chip(cfg);
-      const ReceiverDesign d = design_receiver(cfg);
+      const ReceiverDesign d = family_design(family, r);
       const std::size_t p = ReceiverFixedBatch(d).silence_step();
       if (ReceiverFixedBatch(d).vectorized()) {
         EXPECT_GT(p, 0u) << family << ": silence stays at reset";
@@ -281,10 +283,7 @@ constexpr double kVoltsGain = 1.0 / (0.037 * 2048.0);
 
 TEST(ReceiverBatch, FloatMatchesTheScalarReceiverPerStreamBitForBit) {
   for (const char* family : {"Gold4", "M3"}) {
-    ReceiverConfig cfg;
-    cfg.family = family;
-    fit_decimation_to_chip(cfg);
-    const ReceiverDesign d = design_receiver(cfg);
+    const ReceiverDesign d = family_design(family);
     EXPECT_GT(expect_float_same(d, make_volts(d, 13), kVoltsGain, family), 11u) << family;
   }
 }
@@ -320,10 +319,7 @@ TEST(ReceiverBatch, FloatDetectorGateMatchesAtAnyThresholdAndMinimumEnergy) {
 // a detector whose gate opens on silence (threshold 0, min_energy 0: no fixed point).
 TEST(ReceiverBatch, FloatSkipsLeadingSilenceWithTheSameResults) {
   for (const char* family : {"Gold4", "M3"}) {
-    ReceiverConfig cfg;
-    cfg.family = family;
-    fit_decimation_to_chip(cfg);
-    const ReceiverDesign d = design_receiver(cfg);
+    const ReceiverDesign d = family_design(family);
     ReceiverFloatBatch probe(d);
     const std::size_t p = probe.silence_step();
     if (probe.vectorized()) {
