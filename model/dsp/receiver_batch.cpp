@@ -29,7 +29,7 @@ constexpr std::size_t kChunk = 1024;  // samples per lane per pass of the kernel
 // chunk(n0, n, src, open) processes samples [n0, n0 + n): src[l] points at lane l's sample n0,
 // or at `zeros` (>= kChunk of them) for an ended or unused lane, whose results are discarded;
 // open[l] says whether lane l is still running. The chunks start at sample `start` (<= every
-// lane's length: the samples before it are the caller's, see ReceiverFloatBatch's silence).
+// lane's length: the samples before it are the caller's, see "Silence" below).
 template <class T, class Chunk, class Finish>
 void run_chunks(std::span<const std::span<const T>> streams, const T* zeros, Chunk&& chunk, Finish&& finish,
                 std::size_t start = 0) {
