@@ -65,7 +65,8 @@ std::int64_t quantize_input(double x, int bits, OverflowCounter* counter) {
 namespace {
 // Eight samples at a time from x[i0] while every v = x[i] * gain of a group is within +-1:
 // quantize_input's int64 path (f = floor(v 2^(bits-1+20)), exact: a power of two and |f| <=
-// 2^59; q = (f >> 20) + bit 19 of f; saturated, counted in *sat). Returns where it stopped: the
+// 2^59; q = (f >> 20) + bit 19 of f, >= -2^(bits-1) since v >= -1; saturated at the top, which
+// only v = +1 reaches, counted in *sat). Returns where it stopped: the
 // first group with a lane beyond +-1 or NaN (then the caller's loop), or the last whole group's
 // end. Written with AVX-512 intrinsics: GCC 12 turns the compares of vector extensions into
 // scalar code.
@@ -75,7 +76,6 @@ namespace {
   const __m512d g = _mm512_set1_pd(gain), one = _mm512_set1_pd(1.0), mone = _mm512_set1_pd(-1.0);
   const __m512d scale = _mm512_set1_pd(static_cast<double>(std::int64_t{1} << (bits - 1 + 20)));
   const __m512i hi = _mm512_set1_epi64((std::int64_t{1} << (bits - 1)) - 1);
-  const __m512i lo = _mm512_set1_epi64(-(std::int64_t{1} << (bits - 1)));
   const __m512i bit = _mm512_set1_epi64(1);
   const __mmask8 all = 0xFF;
   std::uint64_t over = 0;
@@ -89,9 +89,8 @@ namespace {
     // (the zero-masked forms, all lanes: the plain ones trip GCC 12's -Wmaybe-uninitialized)
     __m512i q = _mm512_add_epi64(_mm512_maskz_srai_epi64(all, f, 20),
                                  _mm512_and_si512(_mm512_maskz_srai_epi64(all, f, 19), bit));
-    over += static_cast<std::uint64_t>(__builtin_popcount(_mm512_cmpgt_epi64_mask(q, hi)) +
-                                       __builtin_popcount(_mm512_cmplt_epi64_mask(q, lo)));
-    q = _mm512_maskz_max_epi64(all, _mm512_maskz_min_epi64(all, q, hi), lo);
+    over += static_cast<std::uint64_t>(__builtin_popcount(_mm512_cmpgt_epi64_mask(q, hi)));
+    q = _mm512_maskz_min_epi64(all, q, hi);
     _mm512_storeu_si512(out + i, q);
   }
   *sat += over;

@@ -96,6 +96,27 @@ void advance_rings(Bank& b, std::size_t s) {
   b.bd_idx = (b.bd_idx + outputs) % b.bd_n;
   b.f_idx = (b.f_idx + outputs) % b.f_n;
 }
+
+// p samples of silence (rows of zero bits) through a batch's kernels from its current state:
+// filter(in, out, n) is the bandpass, feed(in, n, &ready) the bank's full-rate front end, and
+// at_output() judges each decimated output. False when a bandpass output is not all zero bits
+// or at_output() says no.
+template <class Row, class Filter, class Feed, class AtOutput>
+bool run_silence(std::size_t p, Filter&& filter, Feed&& feed, AtOutput&& at_output) {
+  std::vector<Row> zin(std::min(p, kChunk)), zout(zin.size());
+  for (std::size_t done = 0; done < p;) {
+    const std::size_t n = std::min(zin.size(), p - done);
+    filter(zin.data(), zout.data(), n);
+    if (!zero_bits(zout.data(), n * sizeof(Row))) return false;
+    for (std::size_t i = 0; i < n;) {
+      bool ready = false;
+      i += feed(zout.data() + i, n - i, &ready);
+      if (ready && !at_output()) return false;
+    }
+    done += n;
+  }
+  return true;
+}
 }  // namespace
 
 // The kernels' state: the bandpass lanes and the bank's (bank_lanes.hpp).
@@ -135,19 +156,11 @@ struct ReceiverFixedBatch::Kernels {
     reset();
     const std::size_t p = static_cast<std::size_t>(std::lcm(bank.period, bank.decimation));
     const auto codes = static_cast<std::size_t>(bank.codes);
-    bool ok = p > 0 && (det.threshold_q() > 0 || det.min_norm_q() > 0);
-    std::vector<Lanes> zin(std::min(p, kChunk)), zout(zin.size());
-    for (std::size_t done = 0; ok && done < p;) {
-      const std::size_t n = std::min(zin.size(), p - done);
-      batch::bandpass_batch(bp, zin.data(), zout.data(), n);
-      ok = zero_bits(zout.data(), n * sizeof(Lanes));
-      for (std::size_t i = 0; ok && i < n;) {
-        bool ready = false;
-        i += batch::bank_feed_batch(bank, zout.data() + i, n - i, &ready);
-        if (ready) ok = zero_bits(bank.q, codes * sizeof(Lanes)) && zero_bits(&bank.energy, sizeof(Lanes));
-      }
-      done += n;
-    }
+    bool ok = p > 0 && (det.threshold_q() > 0 || det.min_norm_q() > 0) &&
+              run_silence<Lanes>(
+                  p, [&](const Lanes* in, Lanes* out, std::size_t n) { batch::bandpass_batch(bp, in, out, n); },
+                  [&](const Lanes* in, std::size_t n, bool* ready) { return batch::bank_feed_batch(bank, in, n, ready); },
+                  [&] { return zero_bits(bank.q, codes * sizeof(Lanes)) && zero_bits(&bank.energy, sizeof(Lanes)); });
     for (int l = 0; ok && l < kBatchLanes; ++l) {
       ok = bp_events[l].total() == 0 && lanes.mix_events[l].total() == 0 && lanes.chip_events[l].total() == 0 &&
            lanes.corr_events[l].total() == 0;
@@ -316,22 +329,10 @@ struct ReceiverFloatBatch::Kernels {
   // p samples of +0.0 through the very kernels run_lanes uses; false when a bandpass output is
   // not +0.0 or a gate opens.
   bool run_zeros(std::size_t p, double threshold, double min_energy) {
-    std::vector<LanesF> zin(std::min(p, kChunk)), zout(zin.size());
-    for (std::size_t done = 0; done < p;) {
-      const std::size_t n = std::min(zin.size(), p - done);
-      batch::bandpass_batch_float(bp, zin.data(), zout.data(), n);
-      const bool quiet = std::all_of(zout.begin(), zout.begin() + static_cast<std::ptrdiff_t>(n), [](const LanesF& r) {
-        return std::all_of(std::begin(r.v), std::end(r.v), [](double v) { return std::bit_cast<std::uint64_t>(v) == 0; });
-      });
-      if (!quiet) return false;
-      for (std::size_t i = 0; i < n;) {
-        bool ready = false;
-        i += batch::bank_feed_batch_float(bank, zout.data() + i, n - i, &ready);
-        if (ready && batch::gate_batch_float(bank, threshold, min_energy) != 0) return false;
-      }
-      done += n;
-    }
-    return true;
+    return run_silence<LanesF>(
+        p, [&](const LanesF* in, LanesF* out, std::size_t n) { batch::bandpass_batch_float(bp, in, out, n); },
+        [&](const LanesF* in, std::size_t n, bool* ready) { return batch::bank_feed_batch_float(bank, in, n, ready); },
+        [&] { return batch::gate_batch_float(bank, threshold, min_energy) == 0; });
   }
 
   // Sets silence_step (see above): from reset, P zero samples, then P more must give the same

@@ -310,7 +310,8 @@ struct SceneSimulator::Link {
     for (std::size_t n0 = 0; n0 < volts.size(); n0 += kChunk) {
       const std::size_t n1 = std::min(volts.size(), n0 + kChunk);
       std::int64_t* q = raw.data() + (observed ? n0 : 0);
-      quantize_codes(volts, n0, n1, inv, design.config.bandpass.input_bits, q, adc, clamped);
+      quantize_input_block(std::span<const double>(volts).subspan(n0, n1 - n0), inv, design.config.bandpass.input_bits,
+                           q, adc, clamped, n0);
       rx.execute_block(std::span<const std::int64_t>(q, n1 - n0), raw_events);
       if (scene->receiver.metrics.any()) {  // the float filter runs for the metrics only
         bp.execute_block(std::span<const double>(volts.data() + n0, n1 - n0),
@@ -322,13 +323,6 @@ struct SceneSimulator::Link {
     if (observed) (*observer)(design, raw, raw_events);
     ovf += rx.overflow_events().total() + adc.total();
     return ev;
-  }
-
-  // The ADC codes (bits wide) of volts[n0, n1) / scale, as ReceiverFixed::execute(double)
-  // quantizes them, into q[0, n1 - n0); appends the indices the clamp to +-scale cut to *clamped.
-  static void quantize_codes(std::span<const double> volts, std::size_t n0, std::size_t n1, double inv, int bits,
-                             std::int64_t* q, OverflowCounter& adc, std::vector<std::size_t>* clamped) {
-    quantize_input_block(volts.subspan(n0, n1 - n0), inv, bits, q, adc, clamped, n0);
   }
 
   // One stream of receive_batch: its input, and what receive() gives for it.
@@ -374,8 +368,8 @@ struct SceneSimulator::Link {
     for (std::size_t i = 0; i < streams.size(); ++i) {
       const auto& v = *streams[i].volts;
       codes[i].resize(v.size());
-      quantize_codes(v, 0, v.size(), inv, design.config.bandpass.input_bits, codes[i].data(), adc[i],
-                     streams[i].clamped);
+      quantize_input_block(v, inv, design.config.bandpass.input_bits, codes[i].data(), adc[i],
+                           streams[i].clamped);
       spans.emplace_back(codes[i]);
     }
     std::vector<std::vector<EventFixed>> raw;
@@ -422,7 +416,7 @@ struct SceneSimulator::Link {
         return;
       }
       raw_.resize(x.size());
-      quantize_codes(x, 0, x.size(), inv_, rx_bits_, raw_.data(), adc_, nullptr);
+      quantize_input_block(x, inv_, rx_bits_, raw_.data(), adc_, nullptr);
       raw_events_.clear();
       rx_->execute_block(std::span<const std::int64_t>(raw_.data(), x.size()), raw_events_);
       for (const auto& e : raw_events_) ev.push_back(rx_->to_float(e));
