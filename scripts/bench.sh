@@ -9,7 +9,8 @@
 #   the Verilator RTL of receiver_top vs the model (tb/bench_receiver_top, then its
 #     profile-guided build tb/bench_receiver_top_pgo);
 #   streaming decode of 10 M and 100 M-sample WAV captures (/usr/bin/time -v: CPU time, peak RSS);
-#   scenes per sample: default (float, fixed, fixed without metrics) and minimal (summary.json samples_simulated);
+#   scenes per sample: default (float, fixed, fixed without metrics) and minimal (summary.json samples_simulated),
+#     BENCH_ROUNDS (default 3) interleaved rounds, the median reported;
 #   simulate --jobs 1 against --jobs 2 (wall time: the only clock that shows a parallel speedup);
 #   and the ratios. Rates are per second of CPU time (one core), so a busy machine does not
 #   scale them down. BENCH_DECODE_SAMPLES="1e7 1e8" sets the decode lengths (disk: 4 bytes/sample).
@@ -76,23 +77,32 @@ done
 if cmp -s "$T/jobs1/measurements.csv" "$T/jobs2/measurements.csv"; then echo same; else echo DIFFERENT; fi >"$T/jobs.same"
 # Scenes per sample (only the stages and metrics each names): CPU seconds of a long run minus a
 # 1-repeat run over the samples between them (summary.json samples_simulated), so the one-off
-# design and calibration do not count.
-scene_run() {  # NAME SCENE REPEATS [ARGS...]
-  local name=$1 scene=$2 reps=$3
-  shift 3
-  for r in 1 "$reps"; do
-    /usr/bin/time -f "%U %S" -o "$T/scene.time" "$B"/tool/ranging simulate "$scene" --set geometry.repeats=$r \
-      --out "$T/scene" --quiet --timing "$@" >/dev/null
-    echo "$name $r $(cat "$T/scene.time") $($PY -c 'import json,sys; j = json.load(open(sys.argv[1])); t = j["stage_seconds"]; print(j["samples_simulated"], t["channel"], t["receiver"], t["metrics"])' "$T/scene/summary.json")"
-  done >>"$T/scenes.txt"
+# design and calibration do not count. BENCH_ROUNDS (default 3) rounds, each running every scene
+# once in turn: a change of load on a shared machine then reaches the default scene and the
+# minimal one alike, and each round gives its own ratio (the median round is reported).
+scene_run() {  # ROUND NAME SCENE REPEATS [ARGS...]
+  local round=$1 name=$2 scene=$3 reps=$4
+  shift 4
+  /usr/bin/time -f "%U %S" -o "$T/scene.time" "$B"/tool/ranging simulate "$scene" --set geometry.repeats=$reps \
+    --out "$T/scene" --quiet --timing "$@" >/dev/null
+  echo "$round $name $reps $(cat "$T/scene.time") $($PY -c 'import json,sys; j = json.load(open(sys.argv[1])); t = j["stage_seconds"]; print(j["samples_simulated"], t["channel"], t["receiver"], t["metrics"])' "$T/scene/summary.json")" >>"$T/scenes.txt"
 }
 : >"$T/scenes.txt"
 # (about 1 s of CPU each: /usr/bin/time counts in 10 ms steps, 10 % of the 0.1 s that 400 repeats
 # of the minimal scene took)
-scene_run default scenes/default.yaml 100
-scene_run default-fixed scenes/default.yaml 100 --precision fixed
-scene_run default-fixed-no-metrics scenes/default.yaml 100 --precision fixed --set 'receiver.metrics=[]'
-scene_run minimal scenes/minimal.yaml 4000
+scenes=("default scenes/default.yaml 100" "default-fixed scenes/default.yaml 100 --precision fixed"
+  "default-fixed-no-metrics scenes/default.yaml 100 --precision fixed --set receiver.metrics=[]"
+  "minimal scenes/minimal.yaml 4000")
+for sc in "${scenes[@]}"; do
+  read -r -a a <<<"$sc"
+  scene_run 0 "${a[0]}" "${a[1]}" 1 "${a[@]:3}"
+done
+for ((round = 1; round <= ${BENCH_ROUNDS:-3}; round++)); do
+  for sc in "${scenes[@]}"; do
+    read -r -a a <<<"$sc"
+    scene_run "$round" "${a[@]}"
+  done
+done
 $PY - "$T" <<'PYEOF'
 import json, re, sys
 t = sys.argv[1]
@@ -172,21 +182,30 @@ for j in (1, 2):
 print(f"  speedup (wall, jobs 1 / jobs 2): {w[1][0] / w[2][0]:.2f}; measurements.csv "
       f"{open(f'{t}/jobs.same').read().strip()} (target >= 1.8 on 2 idle cores)")
 print()
-print("Scenes, per received sample (simulate; CPU of a long run minus a 1-repeat run, over the samples between):")
+print("Scenes, per received sample (simulate; CPU of a long run minus a 1-repeat run, over the samples between;")
+print("  the median of the rounds, each round running every scene once in turn):")
 sc = {}
 for line in open(f"{t}/scenes.txt"):
-    name, r, u, sy, n, ch, rx, mt = line.split()
-    sc.setdefault(name, {})[int(r)] = (float(u) + float(sy), int(n), float(ch), float(rx), float(mt))
-ns = {}
+    rnd, name, r, u, sy, n, ch, rx, mt = line.split()
+    sc.setdefault(name, {})[int(rnd)] = (float(u) + float(sy), int(n), float(ch), float(rx), float(mt))
+med = lambda v: sorted(v)[len(v) // 2]
+ns_round = {}  # name -> {round: ns per sample}
 for name, v in sc.items():
-    (c1, n1, ch1, rx1, mt1), (cr, nr, chr_, rxr, mtr) = v[1], max(v.items())[1]
-    ns[name] = (cr - c1) / (nr - n1) * 1e9
-    per = lambda a, b: (b - a) / (nr - n1) * 1e9
-    print(f"  {name:26s} {ns[name]:8.1f} ns/sample {1e3 / ns[name]:8.1f} MS/s {1e3 / ns[name] / 5:8.1f} x real time;"
-          f" per stage (simulate --timing) channel {per(ch1, chr_):5.1f} ({1e3 / max(per(ch1, chr_), 1e-9) / 5:5.1f}x real time),"
-          f" receiver {per(rx1, rxr):5.1f}, metrics {per(mt1, mtr):5.1f} ns/sample")
-print(f"  default / minimal per sample: {ns['default'] / ns['minimal']:.2f} (target >= 5); fixed precision, "
-      f"metrics [] / all: {ns['default-fixed-no-metrics'] / ns['default-fixed']:.2f}")
+    c1, n1, ch1, rx1, mt1 = v[0]
+    per = lambda a, b, nr: (b - a) / (nr - n1) * 1e9
+    ns_round[name] = {k: per(c1, x[0], x[1]) for k, x in v.items() if k > 0}
+    rows = [x for k, x in v.items() if k > 0]
+    ns = med(list(ns_round[name].values()))
+    spread = f"{min(ns_round[name].values()):.1f}-{max(ns_round[name].values()):.1f}"
+    chs, rxs, mts = (med([per(b0, x[i], x[1]) for x in rows]) for i, b0 in ((2, ch1), (3, rx1), (4, mt1)))
+    print(f"  {name:26s} {ns:8.1f} ns/sample ({spread:>9s}) {1e3 / ns:8.1f} MS/s {1e3 / ns / 5:8.1f} x real time;"
+          f" per stage (simulate --timing) channel {chs:5.1f} ({1e3 / max(chs, 1e-9) / 5:5.1f}x real time),"
+          f" receiver {rxs:5.1f}, metrics {mts:5.1f} ns/sample")
+rounds = sorted(ns_round["minimal"])
+ratio = [ns_round["default"][k] / ns_round["minimal"][k] for k in rounds]
+fixed = [ns_round["default-fixed-no-metrics"][k] / ns_round["default-fixed"][k] for k in rounds]
+print(f"  default / minimal per sample: {med(ratio):.2f} (rounds: {', '.join(f'{r:.2f}' for r in ratio)}; target >= 5); "
+      f"fixed precision, metrics [] / all: {med(fixed):.2f}")
 print()
 print("Verilator RTL (tb/bench_receiver_top):")
 for line in open(f"{t}/rtl.txt"):
