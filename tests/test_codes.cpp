@@ -19,6 +19,7 @@
 
 #include "model/dsp/codes.hpp"
 #include "model/base/error.hpp"
+#include "tool/build_info.hpp"
 
 using ranging::Code;
 using ranging::InputError;
@@ -464,6 +465,30 @@ TEST(Cli, ListsPaperFamilies) {
   ASSERT_GE(first_words.size(), paper.size());
   EXPECT_TRUE(std::equal(paper.begin(), paper.end(), first_words.begin())) << r.out;
   EXPECT_EQ(first_words.size(), ranging::code_family_names().size());
+}
+
+// The git_commit every JSON output carries is the source tree's commit when the tool was built
+// (tool/git_commit.cmake runs at every build), not the one its build folder was configured at:
+// a build folder reused across commits stamped outputs with a stale commit. The same git command
+// run here must give the same 12 digits; "-dirty" marks tracked changes, and without git (a
+// source tarball) the tool says "unknown".
+TEST(Cli, GitCommitIsTheCommitTheToolWasBuiltFrom) {
+  const ToolRun r = run_tool("codes --family Gold4 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string got = nlohmann::json::parse(r.out).at("git_commit").get<std::string>();
+  const ToolRun v = ranging::testing_support::run_tool("--version");
+  ASSERT_EQ(v.status, 0) << v.err;
+  EXPECT_EQ(v.out, "ranging " + std::string(ranging::tool::build_info::kVersion) + " (git " + got + ")\n");
+  const ToolRun head = ranging::testing_support::run_command(
+      "git --no-optional-locks -C \"" + std::string(RANGING_SOURCE_DIR) + "\" rev-parse --short=12 HEAD");
+  if (head.status != 0) {
+    EXPECT_EQ(got, "unknown") << head.err;
+    return;
+  }
+  const std::string commit = head.out.substr(0, head.out.find_last_not_of("\n") + 1);
+  ASSERT_EQ(commit.size(), 12u) << head.out;
+  EXPECT_TRUE(got == commit || got == commit + "-dirty")
+      << got << " is not " << commit << "[-dirty] (a tool built before the last commit: rebuild it)";
 }
 
 TEST(Cli, FamilyJsonIsExactlyTheContract) {

@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (args[0] == "--version" || args[0] == "-V") {
-    std::cout << "ranging " << ranging::tool::build_info::kVersion << " (git " << ranging::tool::build_info::kGitCommit
+    std::cout << "ranging " << ranging::tool::build_info::kVersion << " (git " << ranging::tool::build_info::git_commit()
               << ")\n";
     return 0;
   }
