@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -186,9 +187,8 @@ TEST(Capture, WavPcmCodesAreFullScaleFractionsInEveryWidth) {
 
 // simulate --write-captures, then decode every capture back: same code, same distance.
 TEST(DecodeCli, DecodesSimulatedCapturesBackToTheSimulatedResults) {
-  const std::string dir = ::testing::TempDir() + "/capture_rt_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("capture_rt", ::testing::TempDir());
+  const std::string dir = scratch.str();
   const std::string scene = dir + "/rt.yaml";
   write(scene,
         "name: rt\ntransducers: {}\ngeometry:\n  distances_m: [0.25, 0.9]\nexcitation:\n  family: M1\n"
@@ -241,9 +241,8 @@ TEST(DecodeCli, DecodesSimulatedCapturesBackToTheSimulatedResults) {
 // decoded: the receiver's clock moves to 36 MHz (the next multiple the board's PLL makes) with a warning on stderr, the code and distance
 // are the simulated ones.
 TEST(DecodeCli, ACaptureWhoseRateDoesNotDivideTheClockDecodes) {
-  const std::string dir = ::testing::TempDir() + "/capture_4ms_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("capture_4ms", ::testing::TempDir());
+  const std::string dir = scratch.str();
   write(dir + "/s.yaml", "name: r4\nsample_rate: 4000000\ntransducers: {}\ngeometry:\n  distances_m: [0.6]\n"
                          "excitation:\n  family: Gold4\n  codes: [5]\nnoise:\n  noise_v: 0.002\n");
   const ToolRun sim = run_tool("simulate " + dir + "/s.yaml --out " + dir + "/out --write-captures --quiet --json");
@@ -260,9 +259,8 @@ TEST(DecodeCli, ACaptureWhoseRateDoesNotDivideTheClockDecodes) {
 }
 
 TEST(DecodeCli, BadCapturesExitTwoWithAClearMessageAndNoOutput) {
-  const std::string dir = ::testing::TempDir() + "/capture_bad_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("capture_bad", ::testing::TempDir());
+  const std::string dir = scratch.str();
   std::string ok = "TIME,CH1\n";
   for (int n = 0; n < 3000; ++n) ok += sci(n * 2e-7) + "," + std::to_string(std::sin(n * 0.25)) + "\n";
   Capture c;
@@ -312,9 +310,8 @@ TEST(DecodeCli, BadCapturesExitTwoWithAClearMessageAndNoOutput) {
 // Captures carry their metadata (issue 14, section 5): decode uses it unless an option
 // overrides it, and says which it used.
 TEST(DecodeCli, SimulatedCaptureMetadataGivesTheRightDistanceWithDefaultOptions) {
-  const std::string dir = ::testing::TempDir() + "/capture_meta_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("capture_meta", ::testing::TempDir());
+  const std::string dir = scratch.str();
   // Air at 25 C: c = 346.4 m/s, not decode's default 340 (1.9 % = 19 mm at 1 m).
   write(dir + "/m.yaml",
         "name: meta\nmedium: {temperature_c: 25, relative_humidity: 50, pressure_kpa: 101.325}\n"
@@ -471,9 +468,8 @@ TEST(Capture, ChannelsOfAMultiColumnCsvAndAMultiChannelWav) {
 // channel 1 and finds nothing (and says which channel of how many it read); --channel 2 finds
 // the bursts; the JSON carries both; a channel the file lacks exits 2 with nothing on stdout.
 TEST(DecodeCli, ChannelPicksTheColumnOrWavChannelThatHoldsTheSignal) {
-  const std::string dir = ::testing::TempDir() + "/capture_channel_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("capture_channel", ::testing::TempDir());
+  const std::string dir = scratch.str();
   write(dir + "/m.yaml",
         "name: chan\ntransducers: {}\ngeometry:\n  distances_m: [0.5]\nexcitation:\n  family: M1\n  codes: [2]\n"
         "noise:\n  noise_v: 0.001\n  seed: 3\n");
@@ -561,9 +557,8 @@ TEST(Capture, AGivenSampleRateReadsACsvOfSamplesAloneAndReplacesAWavHeadersRate)
 // decode --sample-rate: the simulated capture written as numpy.savetxt writes an array decodes to
 // the same detection as the capture itself; the catalogue's refusals are in test_bad_input.
 TEST(DecodeCli, ACsvOfSamplesAloneDecodesWithItsSampleRateGiven) {
-  const std::string dir = ::testing::TempDir() + "/capture_rate_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("capture_rate", ::testing::TempDir());
+  const std::string dir = scratch.str();
   write(dir + "/m.yaml",
         "name: rate\ntransducers: {}\ngeometry:\n  distances_m: [0.7]\nexcitation:\n  family: M1\n  codes: [1]\n"
         "noise:\n  noise_v: 0.001\n  seed: 5\n");
@@ -590,9 +585,8 @@ TEST(DecodeCli, ACsvOfSamplesAloneDecodesWithItsSampleRateGiven) {
 // A capture at 1 MS/s (5 samples per 200 kHz cycle): the receiver cannot decode a noise-free
 // burst there, so decode refuses (exit 2, nothing on stdout) naming the rate and what to change.
 TEST(DecodeCli, ARateTooLowForTheReceiverIsRefusedNamingTheRate) {
-  const std::string dir = ::testing::TempDir() + "/capture_1ms_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("capture_1ms", ::testing::TempDir());
+  const std::string dir = scratch.str();
   Capture c;
   c.sample_rate = 1e6;
   for (int n = 0; n < 20000; ++n) c.samples.push_back(0.01 * std::sin(0.37 * n * n));
@@ -614,6 +608,7 @@ TEST(Capture, CsvNumbersAreReadExactlyAsStrtodReadsThem) {
       "1.234567890e-03", "+1.5e-3", "-0.000000000e+00", "0", ".5", "1.", "1.e5", "-.5E-3", "0x1p-3",
       "1e-310", "4.9e-324", "2.2250738585072014e-308", "1.7976931348623157e308", "1e309", "9007199254740993",
       "1.00000000000000011102230246251565404236316680908203125", "1e", "1e+", "12abc", "0x", "infinity", "-nan"};
+  const testing_support::ScratchDir scratch("capture_num", ::testing::TempDir());
   for (const auto& s : cells) {
     SCOPED_TRACE(s);
     errno = 0;
@@ -626,7 +621,7 @@ TEST(Capture, CsvNumbersAreReadExactlyAsStrtodReadsThem) {
       ASSERT_TRUE(ok) << "read a cell strtod refuses";
       EXPECT_EQ(std::memcmp(&c.samples[0], &want, sizeof want), 0) << c.samples[0] << " != " << want;
       // the streamed reader's value (csv_row_value) too
-      const fs::path p = fs::path(::testing::TempDir()) / ("num_" + std::to_string(::getpid()) + ".csv");
+      const fs::path p = scratch.path() / "num.csv";
       write(p.string(), text);
       CaptureSource src(p.string());
       std::vector<double> buf(3);

@@ -11,6 +11,8 @@
 #include <memory>
 #include <sstream>
 
+#include "tests/scratch.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -52,9 +54,8 @@ TEST(Evaluate, ReducedPaperSceneReproducesTable6AndTable5AndWritesTheDocument) {
   replace_line("  distances_m: [", "  distances_m: [0.1, 1.0]");
   replace_line("  repeats: ", "  repeats: 2");
   replace_line("name: ", "name: reduced");
-  const std::string dir = ::testing::TempDir() + "/evaluate_reduced_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("evaluate_reduced", ::testing::TempDir());
+  const std::string dir = scratch.str();
   std::ofstream(dir + "/reduced.yaml") << scene;
   const ToolRun r = run_tool("evaluate " + dir + "/reduced.yaml --out " + dir + " --json --quiet");
   ASSERT_EQ(r.status, 0);

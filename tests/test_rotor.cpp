@@ -18,6 +18,7 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 using namespace ranging;
 using ranging::testing_support::run_tool;
@@ -179,13 +180,13 @@ TEST(RotorGeometry, BadGeometryNamesTheKey) {
       "geometry.transducer_radius_fraction");
   has(replace(kRotorScene, "  schedule: {mode: periodic, period_s: 0.00042}\n", ""), "excitation.schedule.period_s");
   // Through the tool: exit 2, nothing on stdout, the key named.
-  const std::string path = ::testing::TempDir() + "/rotor_bad_" + std::to_string(::getpid()) + ".yaml";
+  const testing_support::ScratchDir scratch("rotor_bad", ::testing::TempDir());
+  const std::string path = scratch.file("rotor_bad.yaml");
   std::ofstream(path) << replace(kRotorScene, "rpm: 450", "rpm: 0");
-  const auto r = run_tool("simulate " + path + " --out " + ::testing::TempDir() + "/rotor_bad_out");
+  const auto r = run_tool("simulate " + path + " --out " + scratch.file("rotor_bad_out"));
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_NE(r.err.find("geometry.rpm"), std::string::npos) << r.err;
-  std::filesystem::remove(path);
 }
 
 // Noise-free ToFs computed here by bisection on the circular kinematics (independent of the
@@ -270,7 +271,8 @@ TEST(RotorEstimators, ConsistentChainDropsMisdecodes) {
 
 TEST(RotorScene, SlowCrossingEndToEnd) {
   // 60 RPM: tips at 23 m/s, several bursts inside the 14.5 degree beam; both estimators work.
-  const std::string dir = ::testing::TempDir() + "/rotor_e2e_" + std::to_string(::getpid());
+  const testing_support::ScratchDir scratch("rotor_e2e", ::testing::TempDir());
+  const std::string dir = scratch.file("out");  // made by simulate
   const std::string path = dir + ".yaml";
   std::ofstream(path) << "name: slow\nmedium: {speed_of_sound: 340}\n"
                          "transducers: {beam_angle_deg: 14.5, sensitivity: 0.165}\n"
@@ -297,8 +299,6 @@ TEST(RotorScene, SlowCrossingEndToEnd) {
     EXPECT_GT(c["t_s"].get<double>(), 0);
   }
   EXPECT_TRUE(std::filesystem::exists(dir + "/bursts.csv"));
-  std::filesystem::remove_all(dir);
-  std::filesystem::remove(path);
 }
 
 TEST(RotorDoppler, ConstantLineOfSightSpeed) {
@@ -359,7 +359,8 @@ TEST(RotorDoppler, TwoCyclesPerChipRemedyDoublesTheTolerance) {
 // the received bursts clips, and the run says how many samples (summary and text), where the
 // rotor's own ADC used to clip silently; a DC offset fault moves what the ADC outputs.
 TEST(RotorScene, AdcClippingIsCountedAndFaultsApply) {
-  const std::string dir = ::testing::TempDir() + "/rotor_clip_" + std::to_string(::getpid());
+  const testing_support::ScratchDir scratch("rotor_clip", ::testing::TempDir());
+  const std::string dir = scratch.file("out");  // made by simulate
   auto scene = [&](const std::string& adc) {
     const std::string path = dir + ".yaml";
     std::ofstream(path) << "name: clip\nmedium: {speed_of_sound: 340}\n"
@@ -384,5 +385,4 @@ TEST(RotorScene, AdcClippingIsCountedAndFaultsApply) {
   EXPECT_NE(text.find(std::to_string(n) + " ADC samples clipped"), std::string::npos) << text;
   // A DC offset of 2 full scales puts every sample on the top rail.
   EXPECT_GT(clipped("bits: 12, full_scale_v: 5.0, dc_offset_v: 10.0"), 1000u);
-  std::filesystem::remove_all(dir);
 }

@@ -20,6 +20,7 @@
 #include "model/sim/medium.hpp"
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
+#include "tests/scratch.hpp"
 
 using namespace ranging;
 
@@ -186,8 +187,8 @@ TEST(SceneSimulator, ASampleRateThatDoesNotDivideTheClockMovesTheClockAndDecodes
 // receiver runs on the scene's ADC stream) and a warning names each replaced key; the same file
 // with matching keys gives no warning; the built-in configuration gives none either.
 TEST(Scene, AConfigurationFilesSignalKeysReplacedByTheScenesAreNamed) {
-  const std::string dir = ::testing::TempDir() + "/scene_cfg_" + std::to_string(::getpid());
-  std::filesystem::create_directories(dir);
+  const testing_support::ScratchDir scratch("scene_cfg", ::testing::TempDir());
+  const std::string dir = scratch.str();
   std::ofstream(dir + "/mine.yaml") << "name: mine\nsignal:\n  fs: 4000000\n  cycles_per_chip: 2\n"
                                        "correlator:\n  decimation: 10\nhardware:\n  clock_hz: 24000000\n";
   std::ofstream(dir + "/same.yaml") << "name: same\n";
@@ -278,8 +279,8 @@ TEST(Medium, SpeedOfSoundAndAbsorptionMatchPublishedValues) {
 }
 
 TEST(SimulateCli, WritesCsvAndSummaryAndPrintsStages) {
-  const std::string dir = ::testing::TempDir() + "/sim_cli_" + std::to_string(::getpid());
-  std::filesystem::remove_all(dir);
+  const testing_support::ScratchDir scratch("sim_cli", ::testing::TempDir());
+  const std::string dir = scratch.file("out");  // made by simulate
   const ToolRun r = run_tool("simulate " + std::string(RANGING_SOURCE_DIR) + "/scenes/minimal.yaml --out " + dir +
                              " --quiet");
   ASSERT_EQ(r.status, 0);
@@ -391,8 +392,8 @@ TEST(SceneMetrics, BadMetricsListsNameTheEntryAndTheValidNames) {
 }
 
 TEST(SceneMetrics, SimulateMarksWhatItDidNotComputeAndEvaluateRefusesIt) {
-  const std::string dir = ::testing::TempDir() + "/sim_metrics_" + std::to_string(::getpid());
-  std::filesystem::remove_all(dir);
+  const testing_support::ScratchDir scratch("sim_metrics", ::testing::TempDir());
+  const std::string dir = scratch.file("out");  // made by simulate (and dir + "_t" beside it)
   const std::string scene = std::string(RANGING_SOURCE_DIR) + "/scenes/default.yaml";
   const ToolRun r = run_tool("simulate " + scene + " --set 'receiver.metrics=[td]' --json --quiet --out " + dir);
   ASSERT_EQ(r.status, 0);
@@ -416,14 +417,13 @@ TEST(SceneMetrics, SimulateMarksWhatItDidNotComputeAndEvaluateRefusesIt) {
   const ToolRun ev = run_tool("evaluate " + scene + " --set 'receiver.metrics=[]' --out " + dir + "_e");
   EXPECT_EQ(ev.status, 2);
   EXPECT_TRUE(ev.out.empty());
-  std::filesystem::remove_all(dir);
-  std::filesystem::remove_all(dir + "_t");
 }
 
 // simulate --timing: summary.json carries the seconds per stage (each >= 0; the default scene
 // spends time in all three), and only when asked (the summary is otherwise reproducible).
 TEST(SimulateCli, TimingRecordsTheSecondsPerStageOnlyWhenAsked) {
-  const std::string dir = ::testing::TempDir() + "/sim_timing_" + std::to_string(::getpid());
+  const testing_support::ScratchDir scratch("sim_timing", ::testing::TempDir());
+  const std::string dir = scratch.file("out");  // made by simulate
   const std::string scene = std::string(RANGING_SOURCE_DIR) + "/scenes/default.yaml";
   const ToolRun t = run_tool("simulate " + scene + " --quiet --timing --out " + dir);
   ASSERT_EQ(t.status, 0) << t.out;
@@ -440,5 +440,4 @@ TEST(SimulateCli, TimingRecordsTheSecondsPerStageOnlyWhenAsked) {
   ASSERT_EQ(n.status, 0) << n.out;
   std::ifstream js(dir + "/summary.json");
   EXPECT_FALSE(nlohmann::json::parse(js).contains("stage_seconds"));
-  std::filesystem::remove_all(dir);
 }

@@ -28,20 +28,17 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 using namespace ranging;
 namespace fs = std::filesystem;
 
 namespace {
 
+// Shared by the tests; removed at exit.
 fs::path temp_dir() {
-  static const fs::path d = [] {
-    fs::path p = fs::temp_directory_path() / ("ranging_stream_" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
-    return p;
-  }();
-  return d;
+  static const testing_support::ScratchDir d("ranging_stream");
+  return d.path();
 }
 
 // A periodic Gold4 train at 0.3 m with noise (bursts every 0.002 s, 10 bursts, ~110 k samples).

@@ -12,15 +12,15 @@
 #include "model/config/receiver_config.hpp"
 #include "model/study/sweep.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 using nlohmann::json;
 using ranging::testing_support::run_tool;
 namespace fs = std::filesystem;
 
 TEST(WordLength, TheMinimumPassesOneBitLessFailsAndTheConfigurationCarriesIt) {
-  const fs::path dir = fs::temp_directory_path() / ("ranging_wordlength_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_wordlength");
+  const fs::path dir = scratch.path();
   std::ofstream(dir / "scene.yaml") << "transducers: {}\ngeometry:\n  distances_m: [0.3, 0.8]\nexcitation:\n"
                                        "  family: Gold4\n  codes: [1, 5, 9]\nnoise:\n  noise_v: 0.01\n  seed: 2\n";
   std::ofstream(dir / "spec.yaml") << "name: wl\nconfig: " << RANGING_SOURCE_DIR << "/configs/default.yaml\n"
@@ -55,15 +55,13 @@ TEST(WordLength, TheMinimumPassesOneBitLessFailsAndTheConfigurationCarriesIt) {
   EXPECT_TRUE(bad.out.empty());
   EXPECT_NE(bad.err.find((dir / "bad.yaml").string() + ":4: nodes"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad"));
-  fs::remove_all(dir);
 }
 
 // --jobs N searches the nodes on N threads: the result is the one thread's (only the points'
 // measured speed differs), and the evaluations are counted once each.
 TEST(WordLength, SeveralThreadsGiveTheSameResult) {
-  const fs::path dir = fs::temp_directory_path() / ("ranging_wordlength_jobs_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_wordlength_jobs");
+  const fs::path dir = scratch.path();
   std::ofstream(dir / "scene.yaml") << "transducers: {}\ngeometry:\n  distances_m: [0.3, 0.8]\nexcitation:\n"
                                        "  family: Gold4\n  codes: [2, 7]\nnoise:\n  noise_v: 0.01\n  seed: 3\n";
   std::ofstream(dir / "spec.yaml") << "name: wl\nconfig: " << RANGING_SOURCE_DIR << "/configs/default.yaml\n"

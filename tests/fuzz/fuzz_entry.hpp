@@ -19,6 +19,7 @@
 #include "model/sim/capture.hpp"
 #include "model/sim/scene.hpp"
 #include "model/study/sweep.hpp"
+#include "tests/scratch.hpp"
 
 namespace ranging::fuzz {
 
@@ -96,9 +97,10 @@ inline int uart_frames(const std::uint8_t* data, std::size_t size) {
 // sweeps/smoke-scene.yaml (as smoke-scene.yaml); source_dir is the repository.
 inline int sweep_spec(const std::uint8_t* data, std::size_t size, const std::string& source_dir) {
   namespace fs = std::filesystem;
+  // The folder is removed at exit (a function-local static).
+  static const testing_support::ScratchDir scratch("ranging-fuzz-sweep");
   static const fs::path dir = [&] {
-    const fs::path d = fs::temp_directory_path() / ("ranging-fuzz-sweep-" + std::to_string(::getpid()));
-    fs::create_directories(d);
+    const fs::path d = scratch.path();
     fs::copy_file(fs::path(source_dir) / "configs/default.yaml", d / "default.yaml", fs::copy_options::overwrite_existing);
     fs::copy_file(fs::path(source_dir) / "sweeps/smoke-scene.yaml", d / "smoke-scene.yaml", fs::copy_options::overwrite_existing);
     return d;
