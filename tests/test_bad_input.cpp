@@ -22,6 +22,7 @@
 #include "model/base/error.hpp"
 #include "model/sim/capture.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace fs = std::filesystem;
 using ranging::testing_support::run_command;
@@ -263,11 +264,8 @@ class BadInput : public ::testing::TestWithParam<Case> {};
 
 TEST_P(BadInput, RefusedWithExit2AndNamedFieldAndNoOutput) {
   const Case& c = GetParam();
-  const fs::path dir = fs::temp_directory_path() / ("ranging_bad_" + std::to_string(::getpid()) + "_" +
-                                                     std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                                     "_" + std::to_string(std::hash<std::string>{}(c.name)));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_bad");
+  const fs::path dir = scratch.path();
   for (const auto& [name, content] : c.files) {
     if (content == kDir) {
       fs::create_directories(dir / name);
@@ -287,7 +285,6 @@ TEST_P(BadInput, RefusedWithExit2AndNamedFieldAndNoOutput) {
         << "stderr lacks '" << replace_all(want, "{d}", d) << "'\nstderr: " << r.err;
   }
   EXPECT_EQ(tree(dir), before) << "the run created, changed or left files in " << d;
-  fs::remove_all(dir);
 }
 
 std::string case_name(const ::testing::TestParamInfo<Case>& info) {
@@ -302,9 +299,8 @@ TEST(BadInputCatalogue, HasAtLeastFortyCases) { EXPECT_GE(catalogue().size(), 40
 
 // CRLF line endings and a UTF-8 BOM are accepted: the same output as the plain file.
 TEST(BadInput, CrlfAndBomAreAccepted) {
-  const fs::path dir = fs::temp_directory_path() / ("ranging_crlf_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_crlf");
+  const fs::path dir = scratch.path();
   const std::string cfg = default_config();
   const std::string crlf = replace_all(cfg, "\n", "\r\n");
   const std::string bom = "\xEF\xBB\xBF";
@@ -335,7 +331,6 @@ TEST(BadInput, CrlfAndBomAreAccepted) {
     if (ref_csv.empty()) ref_csv = csv;
     EXPECT_EQ(csv, ref_csv) << name;
   }
-  fs::remove_all(dir);
 }
 
 // The shared writer: /dev/full is reported (ENOSPC) and written in place, never replaced by a
@@ -349,8 +344,8 @@ TEST(AtomicFile, ReportsDiskFullAndLeavesNoTemporary) {
     EXPECT_NE(std::string(e.what()).find("No space left"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(fs::is_character_file("/dev/full"));
-  const fs::path dir = fs::temp_directory_path() / ("ranging_atomic_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_atomic");
+  const fs::path dir = scratch.path();
   fs::create_directories(dir / "sub");
   EXPECT_THROW(ranging::write_file_atomic((dir / "sub").string(), "x"), ranging::InputError);
   EXPECT_THROW(ranging::write_file_atomic((dir / "missing" / "f").string(), "x"), ranging::InputError);
@@ -360,7 +355,6 @@ TEST(AtomicFile, ReportsDiskFullAndLeavesNoTemporary) {
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++entries;
   EXPECT_EQ(entries, 2u);  // sub and f.txt: no temporary left
-  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace {
 
@@ -19,13 +20,6 @@ using ranging::testing_support::run_command;
 using ranging::testing_support::run_tool;
 
 const std::string kDefault = std::string(RANGING_SOURCE_DIR) + "/configs/default.yaml";
-
-std::string temp_dir(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "/" + name + "_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 void write_script(const std::string& path, const std::string& body) {
   std::ofstream(path) << "#!/bin/sh\n" << body;
@@ -60,18 +54,19 @@ TEST(BitstreamCli, BadOptionsAreRefused) {
     EXPECT_TRUE(r.out.empty()) << c.args << ": " << r.out;
     EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << ": " << r.err;
   }
-  const std::string dir = temp_dir("bitstream_bad");
+  const ranging::testing_support::ScratchDir scratch("bitstream_bad", ::testing::TempDir());
+  const std::string dir = scratch.str();
   std::ofstream(dir + "/c.yaml") << "name: x\nsystem:\n  baud: 7\n";
   const auto r = run_tool("bitstream --config " + dir + "/c.yaml --out " + dir + "/out");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find(dir + "/c.yaml:3: system.baud"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir + "/out"));
-  fs::remove_all(dir);
 }
 
 // No iceprog and no openFPGALoader on PATH: refused at once, nothing built.
 TEST(BitstreamCli, ProgramWithoutAProgrammerFailsBeforeBuilding) {
-  const std::string dir = temp_dir("bitstream_noprog");
+  const ranging::testing_support::ScratchDir scratch("bitstream_noprog", ::testing::TempDir());
+  const std::string dir = scratch.str();
   const auto r = run_command("PATH=" + dir + " " + tool() + " bitstream --config " + kDefault + " --program --out " +
                              dir + "/out");
   EXPECT_EQ(r.status, 2);
@@ -81,12 +76,12 @@ TEST(BitstreamCli, ProgramWithoutAProgrammerFailsBeforeBuilding) {
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(dir + "/out"));
-  fs::remove_all(dir);
 }
 
 // iceprog installed, no board attached (its probe fails as the real one does without a board).
 TEST(BitstreamCli, ProgramWithoutABoardFailsBeforeBuilding) {
-  const std::string dir = temp_dir("bitstream_noboard");
+  const ranging::testing_support::ScratchDir scratch("bitstream_noboard", ::testing::TempDir());
+  const std::string dir = scratch.str();
   write_script(dir + "/iceprog", "echo \"Can't find iCE FTDI USB device (vendor_id 0x0403, device_id 0x6010 or 0x6014).\"\n"
                                  "echo ABORT.\nexit 2\n");
   const auto r = run_command("PATH=" + dir + ":/usr/bin:/bin " + tool() + " bitstream --config " + kDefault +
@@ -96,12 +91,12 @@ TEST(BitstreamCli, ProgramWithoutABoardFailsBeforeBuilding) {
   EXPECT_NE(r.err.find("option --program: no iCEBreaker board answers (`iceprog -t`: ABORT.)"), std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(dir + "/out"));
-  fs::remove_all(dir);
 }
 
 // --program --bin FILE: probe, then write the given bitstream; nothing is built.
 TEST(BitstreamCli, ProgramsAnExistingBitstream) {
-  const std::string dir = temp_dir("bitstream_prog");
+  const ranging::testing_support::ScratchDir scratch("bitstream_prog", ::testing::TempDir());
+  const std::string dir = scratch.str();
   write_script(dir + "/iceprog", "echo \"$@\" >> " + dir + "/calls\n");
   std::ofstream(dir + "/my.bin") << "not really a bitstream";
   auto r = run_command("PATH=" + dir + ":/usr/bin:/bin " + tool() + " bitstream --program --bin " + dir + "/my.bin");
@@ -120,7 +115,6 @@ TEST(BitstreamCli, ProgramsAnExistingBitstream) {
   r = run_command("PATH=" + dir + ":/usr/bin:/bin " + tool() + " bitstream --program --bin " + dir + "/none.bin");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("option --bin: no file"), std::string::npos) << r.err;
-  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 using namespace ranging;
 
@@ -147,9 +148,8 @@ TEST(ParallelStreams, FloatPeriodicIsIdenticalWithOneAndTwoThreads) {
 
 TEST(ParallelStreams, SimulateWritesTheSameFilesWithJobs) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("ranging_parallel_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("ranging_parallel");
+  const fs::path dir = scratch.path();
   {
     std::ofstream(dir / "s.yaml") << scene_yaml("fixed", false);
   }
@@ -171,5 +171,4 @@ TEST(ParallelStreams, SimulateWritesTheSameFilesWithJobs) {
   EXPECT_TRUE(bad.out.empty());
   EXPECT_NE(bad.err.find("--jobs"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad"));
-  fs::remove_all(dir);
 }

@@ -15,6 +15,7 @@
 #include "model/dsp/codes.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 using namespace ranging;
 
@@ -107,9 +108,8 @@ TEST(SystemKeys, UsedByTheGenerator) {
 
 // Checks made only when the system is designed are located in the file too.
 TEST(SystemKeys, GenerateLocatesSystemDesignErrors) {
-  const std::string dir = ::testing::TempDir() + "/system_keys_" + std::to_string(::getpid());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("system_keys", ::testing::TempDir());
+  const std::string dir = scratch.str();
   // holdoff 5000 samples > the burst period of 1 m (1634 samples)
   std::ofstream(dir + "/c.yaml") << "detector:\n  holdoff: 5000\nsystem:\n  max_range_m: 1\n";
   const auto r = ranging::testing_support::run_tool("generate --config " + dir + "/c.yaml --out " + dir + "/gen");
@@ -127,7 +127,6 @@ TEST(SystemKeys, GenerateLocatesSystemDesignErrors) {
   EXPECT_TRUE(g.out.empty()) << g.out;
   EXPECT_NE(g.err.find(dir + "/b.yaml:3: system.baud"), std::string::npos) << g.err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/gen"));
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
