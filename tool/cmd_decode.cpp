@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -324,14 +325,24 @@ int cmd_decode(const Args& args) {
     plot_decode(*p.get("--plot"), scene, family, read_capture(path, how), fs, dets, below);
   }
   const bool known = meta.code_sent && *meta.code_sent > 0;
+  // A burst that arrives before its code was first sent (an echo of a burst sent before the
+  // capture's t = 0, or a misdecode) has no time of flight: null, never a distance from t = 0.
+  std::size_t unsent = 0;
+  for (const auto* v : {&dets, &below}) {
+    for (const auto& d : *v) unsent += d.tof_from_send ? 0 : 1;
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto tof_of = [&](const Detection& d) { return d.tof_from_send ? d.tof_s : nan; };
   auto det_json = [&](const Detection& d) {
-    nlohmann::json o = {{"code", d.code}, {"tof_s", d.tof_s}, {"distance_m", d.tof_s * c.value},
+    const double tof = tof_of(d);
+    nlohmann::json o = {{"code", d.code}, {"tof_s", tof}, {"distance_m", tof * c.value},
                         {"rho", d.rho_max}, {"pearson_margin", d.pearson_margin}, {"pearson_code", d.pearson_code},
                         {"receiver_rho2", d.score}};
     if (known && d.rho.size() >= 2 && *meta.code_sent <= static_cast<int>(d.rho.size())) {
       o["u"] = u_for_sent(d.rho, *meta.code_sent);  // eq. 10, with the code the metadata says was sent
     }
-    if (meta.true_distance_m) o["error_m"] = d.tof_s * c.value - *meta.true_distance_m;
+    if (meta.true_distance_m) o["error_m"] = tof * c.value - *meta.true_distance_m;
+    if (!d.tof_from_send) o["arrival_s"] = d.arrival_s;
     return o;
   };
 
@@ -364,6 +375,7 @@ int cmd_decode(const Args& args) {
     j["below_gate"] = nlohmann::json::array();
     for (const auto& d : below) j["below_gate"].push_back(det_json(d));
     j["found"] = !dets.empty();
+    j["arrivals_before_first_send"] = unsent;  // their tof_s and distance_m are null
     j["input_clipping"] = {{"samples", clip.samples}, {"runs", clip.runs}, {"max", clip.high}, {"min", clip.low},
                            {"rule", "runs of >= 3 consecutive samples at the capture's maximum or minimum"}};
     std::string text = stamp_build_info(j).dump(2);
@@ -381,13 +393,27 @@ int cmd_decode(const Args& args) {
     std::printf("%s: %zu samples at %.6g MS/s%s, family %s, c = %.2f m/s%s\n", path.c_str(), cap.size(),
                 cap.sample_rate() / 1e6, chan.c_str(), family.c_str(), c.value, cal ? ", latency calibrated" : "");
     std::printf("%5s %12s %12s %8s %8s\n", "code", "tof_us", "distance_mm", "rho_max", "margin");
+    auto row = [&](const Detection& d) {
+      if (d.tof_from_send) {
+        std::printf("%5d %12.3f %12.3f %8.4f %8.4f", d.code, d.tof_s * 1e6, d.tof_s * c.value * 1e3, d.rho_max,
+                    d.pearson_margin);
+      } else {
+        std::printf("%5d %12s %12s %8.4f %8.4f  arrived at %.3f us, before code %d was first sent: no ToF", d.code,
+                    "-", "-", d.rho_max, d.pearson_margin, d.arrival_s * 1e6, d.code);
+      }
+    };
     for (const auto& d : dets) {
-      std::printf("%5d %12.3f %12.3f %8.4f %8.4f\n", d.code, d.tof_s * 1e6, d.tof_s * c.value * 1e3, d.rho_max,
-                  d.pearson_margin);
+      row(d);
+      std::printf("\n");
     }
     for (const auto& d : below) {
-      std::printf("%5d %12.3f %12.3f %8.4f %8.4f  below the gate (rho %.4f < --min-rho %.4g)\n", d.code,
-                  d.tof_s * 1e6, d.tof_s * c.value * 1e3, d.rho_max, d.pearson_margin, d.rho_max, min_rho);
+      row(d);
+      std::printf("  below the gate (rho %.4f < --min-rho %.4g)\n", d.rho_max, min_rho);
+    }
+    if (unsent > 0) {
+      std::printf("%zu burst(s) arrived before their code was first sent: echoes of bursts sent before the capture's "
+                  "t = 0 (t = 0 must be the first burst's start), or misdecodes; no distance is given for them\n",
+                  unsent);
     }
     if (dets.empty()) {
       std::printf(below.empty() ? "no burst detected\n" : "no burst passed the gate\n");

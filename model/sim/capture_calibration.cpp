@@ -19,8 +19,13 @@ LatencyCalibration calibrate_latency(const std::vector<Detection>& dets, double 
   if (dets.empty()) throw InputError(what + ": the receiver detects no burst in the calibration capture");
   std::map<int, const Detection*> best;
   for (const auto& d : dets) {
+    if (!d.tof_from_send) continue;  // no send of its code before it: no ToF to calibrate with
     auto& b = best[d.code];
     if (!b || d.score > b->score) b = &d;
+  }
+  if (best.empty()) {
+    throw InputError(what + ": every burst the receiver detects arrives before its code was first sent (the "
+                     "capture's t = 0 is not the first burst's start, or its period is wrong)");
   }
   LatencyCalibration cal;
   double sum = 0;

@@ -23,8 +23,10 @@ struct LatencyCalibration {
 };
 
 // From the detections of a calibration capture taken at distance_m with speed of sound c.
-// Where a code appears more than once, the strongest detection (receiver score) is used.
-// InputError naming `what` (the option) if there are no detections or the ranges are invalid.
+// Where a code appears more than once, the strongest detection (receiver score) is used;
+// detections with no send of their code before them (Detection::tof_from_send false) have no
+// ToF and are left out. InputError naming `what` (the option) if no detection is left or the
+// ranges are invalid.
 LatencyCalibration calibrate_latency(const std::vector<Detection>& dets, double distance_m, double c,
                                      const std::string& what);
 

@@ -448,8 +448,8 @@ RotorRun run_rotor(SceneSimulator& sim, const std::function<void()>& tick) {
       } else {
         ++run.false_alarms;
       }
-      // What the system can check by itself: the ToF is in range.
-      if (m.tof_s > 0 && m.distance_m <= L && m.score >= p.accept_score) samples.push_back({m.t_emit_s, m.tof_s});
+      // What the system can check by itself: a send of the code precedes it, the ToF is in range.
+      if (d.tof_from_send && m.tof_s > 0 && m.distance_m <= L && m.score >= p.accept_score) samples.push_back({m.t_emit_s, m.tof_s});
       rc.list.push_back(m);
     }
     samples = consistent_chain(samples, c, run.v_rel, p.chain_tolerance_m);

@@ -614,9 +614,13 @@ struct SceneSimulator::Link {
     const double a = e.arrival - offset[static_cast<std::size_t>(e.code - 1)];
     d.arrival_s = t0 + a / fs();
     double tx = 0;
+    d.tof_from_send = false;
     if (auto sit = sends.find(e.code); sit != sends.end()) {
       const auto& v = sit->second;
-      if (auto it = std::upper_bound(v.begin(), v.end(), d.arrival_s); it != v.begin()) tx = *(it - 1);
+      if (auto it = std::upper_bound(v.begin(), v.end(), d.arrival_s); it != v.begin()) {
+        tx = *(it - 1);
+        d.tof_from_send = true;
+      }
     }
     d.tof_s = d.arrival_s - tx;
     p.start = std::lround(a);

@@ -66,7 +66,10 @@ std::vector<SceneStage> scene_stages(const Scene& scene);
 struct Detection {
   int code = 0;            // 1-based j (receiver bank)
   double arrival_s = 0;    // calibrated arrival time from t = 0 (start of the first burst)
-  double tof_s = 0;        // arrival - transmission time of the burst that carried code j
+  double tof_s = 0;        // arrival - transmission time of the burst that carried code j: the latest
+                           // send of code j at or before the arrival; with none, the arrival itself
+  bool tof_from_send = true;  // false: no send of code j at or before the arrival (an echo of a burst
+                              // sent before t = 0, or a misdecode), so tof_s is only the time from t = 0
   double score = 0;        // receiver rho^2 at the peak (hardware detector)
   double detector_margin = 0;  // receiver rho^2(best) - rho^2(second) at the peak
   // The paper's Pearson matched filter (eq. 9 over lags, +-L chips around the arrival).
