@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace {
 
@@ -26,8 +27,8 @@ std::string fmt_mhz(double v) {
 
 TEST(BitstreamSoak, UserConfigurationPlacedAndRoutedWithParallelSeeds) {
   if (std::system("command -v nextpnr-ice40 >/dev/null") != 0) GTEST_FAIL() << "nextpnr-ice40 not installed";
-  const std::string dir = ::testing::TempDir() + "/bitstream_soak_" + std::to_string(::getpid());
-  fs::remove_all(dir);
+  const ranging::testing_support::ScratchDir scratch("bitstream_soak", ::testing::TempDir());
+  const std::string dir = scratch.file("out");  // made by the tool
   const auto r = ranging::testing_support::run_tool(
       "bitstream --config " + std::string(RANGING_SOURCE_DIR) +
       "/configs/default.yaml --set system.baud=1000000 --set system.max_range_m=2 --seeds 2 --jobs 2 --check --out " + dir);
@@ -56,7 +57,6 @@ TEST(BitstreamSoak, UserConfigurationPlacedAndRoutedWithParallelSeeds) {
   }
   EXPECT_TRUE(fs::exists(dir + "/seed-1/nextpnr.log") && fs::exists(dir + "/seed-2/nextpnr.log"));
   EXPECT_GT(fs::file_size(dir + "/ranging_icebreaker.bin"), 100000u);
-  fs::remove_all(dir);
 }
 
 }  // namespace

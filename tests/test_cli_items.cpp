@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace fs = std::filesystem;
 using ranging::testing_support::run_command;
@@ -48,7 +49,8 @@ TEST(CliItems, VersionNamesTheVersionAndTheGitCommit) {
 TEST(CliItems, EveryJsonOutputCarriesVersionAndCommit) {
   const std::string v = tool_version();
   ASSERT_FALSE(v.empty());
-  const fs::path tmp = fs::temp_directory_path() / ("ranging_cli_items_" + std::to_string(::getpid()));
+  const ranging::testing_support::ScratchDir scratch("ranging_cli_items");
+  const fs::path tmp = scratch.path() / "out";  // made by simulate
   for (const std::string& cmd : std::vector<std::string>{"codes --family M1 --json", "codes --degree 5 --json", "codes --list --json",
                                 "filter --json", "demo --family M1 --distances 0.5 --json",
                                 "simulate " + std::string(RANGING_SOURCE_DIR) + "/scenes/minimal.yaml --json --quiet --out " +
@@ -59,7 +61,6 @@ TEST(CliItems, EveryJsonOutputCarriesVersionAndCommit) {
     EXPECT_EQ(j.value("version", ""), v) << cmd;
     EXPECT_FALSE(j.value("git_commit", "").empty()) << cmd;
   }
-  fs::remove_all(tmp);
 }
 
 TEST(CliItems, TheCommandListSeparatesEveryNameFromItsSummary) {
@@ -130,9 +131,8 @@ TEST(CliItems, CodesListJsonListsEveryFamily) {
 }
 
 TEST(CliItems, EvaluateWithoutOutWritesUnderOutNotDocs) {
-  const fs::path cwd = fs::temp_directory_path() / ("ranging_eval_cwd_" + std::to_string(::getpid()));
-  fs::remove_all(cwd);
-  fs::create_directories(cwd);
+  const ranging::testing_support::ScratchDir scratch("ranging_eval_cwd");
+  const fs::path cwd = scratch.path();
   std::ifstream in(std::string(RANGING_SOURCE_DIR) + "/scenes/paper-section4.yaml");
   std::stringstream ss;
   ss << in.rdbuf();
@@ -151,7 +151,6 @@ TEST(CliItems, EvaluateWithoutOutWritesUnderOutNotDocs) {
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(cwd / "out/tiny/tiny.md"));
   EXPECT_FALSE(fs::exists(cwd / "docs"));
-  fs::remove_all(cwd);
 }
 
 // Every command's --help: below "options:" (and "arguments:"), a line is an option or positional

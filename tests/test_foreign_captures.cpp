@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace fs = std::filesystem;
 using ranging::testing_support::run_command;
@@ -32,8 +33,8 @@ class ForeignCaptures : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(ForeignCaptures, EveryCodeRightAndEveryDistanceWithin2mm) {
   const std::string family = GetParam();
-  const std::string dir = ::testing::TempDir() + "/foreign_" + family + "_" + std::to_string(::getpid());
-  fs::remove_all(dir);
+  const ranging::testing_support::ScratchDir scratch("foreign_" + family, ::testing::TempDir());
+  const std::string dir = scratch.file("captures");  // made by foreign_channel.py
   const std::string cmd = std::string(RANGING_PYTHON) + " " + RANGING_SOURCE_DIR + "/tests/oracle/foreign_channel.py " +
                           dir + " " + family + " 14";
   const auto gen = run_command(cmd);
@@ -67,15 +68,13 @@ TEST_P(ForeignCaptures, EveryCodeRightAndEveryDistanceWithin2mm) {
     }
   }
   EXPECT_EQ(checked, 2 * static_cast<int>(truth["captures"].size()));
-  fs::remove_all(dir);
 }
 
 INSTANTIATE_TEST_SUITE_P(Families, ForeignCaptures, ::testing::Values("M1", "Gold4"));
 
 TEST(DecodeExitStatus, NothingFoundIsOneAndBelowGateBurstsAreListed) {
-  const std::string dir = ::testing::TempDir() + "/exit_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("exit", ::testing::TempDir());
+  const std::string dir = scratch.str();
   // Silence: nothing at all -> exit 1, "no burst detected".
   {
     std::ofstream out(dir + "/quiet.csv");
@@ -99,5 +98,4 @@ TEST(DecodeExitStatus, NothingFoundIsOneAndBelowGateBurstsAreListed) {
   const auto t = run_tool("decode " + dir + "/f/M1_j1.csv --family M1 --min-rho 1");
   EXPECT_EQ(t.status, 1);
   EXPECT_NE(t.out.find("below the gate"), std::string::npos) << t.out;
-  fs::remove_all(dir);
 }

@@ -10,6 +10,7 @@
 
 #include "model/hw/frames.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 using namespace ranging;
 namespace fs = std::filesystem;
@@ -98,7 +99,8 @@ TEST(Frames, ATruncatedLastFrameIsReported) {
 }
 
 TEST(Frames, CommandReadsAFileOrStdinAndCountsBadFrames) {
-  const fs::path p = fs::temp_directory_path() / ("ranging_frames_" + std::to_string(::getpid()) + ".bin");
+  const testing_support::ScratchDir scratch("ranging_frames");
+  const fs::path p = scratch.path() / "frames.bin";
   auto bytes = three();
   bytes[kUartFrameBytes + 9] ^= 0x01;  // frame 2's distance: checksum fails
   std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
@@ -119,5 +121,4 @@ TEST(Frames, CommandReadsAFileOrStdinAndCountsBadFrames) {
   r = testing_support::run_tool("frames " + p.string() + ".missing");
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.out, "");
-  fs::remove(p);
 }

@@ -12,6 +12,7 @@
 #include "model/sim/demo.hpp"
 #include "model/base/error.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 #include "model/hw/hw_generator.hpp"
 #include "model/hw/hw_params.hpp"
 
@@ -23,14 +24,20 @@ namespace {
 using ToolRun = testing_support::ProcessResult;
 using testing_support::run_tool;
 
+// Every test's files in one directory, removed at exit.
+const fs::path& scratch_dir() {
+  static const testing_support::ScratchDir d("ranging_gen");
+  return d.path();
+}
+
 fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("ranging_gen_" + name + "_" + std::to_string(::getpid()));
+  const fs::path p = scratch_dir() / ("gen_" + name);
   fs::remove_all(p);
   return p;
 }
 
 fs::path write_config(const std::string& name, const std::string& text) {
-  const fs::path p = fs::temp_directory_path() / ("ranging_cfg_" + name + "_" + std::to_string(::getpid()) + ".yaml");
+  const fs::path p = scratch_dir() / ("cfg_" + name + ".yaml");
   std::ofstream(p) << text;
   return p;
 }

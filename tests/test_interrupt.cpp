@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace fs = std::filesystem;
 
@@ -99,9 +100,8 @@ class Interrupt : public ::testing::TestWithParam<int> {};
 
 TEST_P(Interrupt, SimulateLeavesPreviousOutputsAndNoTemporaries) {
   const int sig = GetParam();
-  const fs::path dir = fs::temp_directory_path() / ("ranging_int_" + std::to_string(::getpid()) + "_" + std::to_string(sig));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_int_" + std::to_string(sig));
+  const fs::path dir = scratch.path();
   // A short run fills the output folder; a long one into the same folder is interrupted.
   std::ofstream(dir / "short.yaml") << "name: s\ngeometry:\n  distances_m: [0.5]\n";
   std::ofstream(dir / "long.yaml") << "name: s\ngeometry:\n  distances_m: [0.2, 0.4, 0.6, 0.8, 1.0]\n"
@@ -125,7 +125,6 @@ TEST_P(Interrupt, SimulateLeavesPreviousOutputsAndNoTemporaries) {
   const auto again = ranging::testing_support::run_tool("simulate --quiet " + (dir / "short.yaml").string() + " --out " + out);
   EXPECT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(files_in(out), before);
-  fs::remove_all(dir);
 }
 
 // A sweep interrupted part-way leaves only whole files (every point file parses, no temporary,
@@ -133,9 +132,8 @@ TEST_P(Interrupt, SimulateLeavesPreviousOutputsAndNoTemporaries) {
 // before are kept, the rest are evaluated, and the outputs are complete.
 TEST(InterruptSweep, SigtermLeavesWholePointFilesAndResumes) {
   const int sig = SIGTERM;
-  const fs::path dir = fs::temp_directory_path() / ("ranging_int_sweep_" + std::to_string(::getpid()) + "_" + std::to_string(sig));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_int_sweep_" + std::to_string(sig));
+  const fs::path dir = scratch.path();
   const std::string src = RANGING_SOURCE_DIR;
   // Ten distances per point (about a second each here), five points; the signal comes as soon
   // as the first point file is there.
@@ -171,14 +169,12 @@ TEST(InterruptSweep, SigtermLeavesWholePointFilesAndResumes) {
   const auto doc = nlohmann::json::parse(slurp(fs::path(out) / "sweep.json"));
   ASSERT_TRUE(doc.contains("points"));
   EXPECT_EQ(doc["points"].size(), 5u);  // 4 values of the axis and the base point
-  fs::remove_all(dir);
 }
 
 // The paper's evaluation, interrupted: the outputs of the run before are untouched.
 TEST(InterruptEvaluate, SigtermLeavesThePreviousResults) {
-  const fs::path dir = fs::temp_directory_path() / ("ranging_int_eval_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_int_eval");
+  const fs::path dir = scratch.path();
   const std::string paper = slurp(fs::path(RANGING_SOURCE_DIR) / "scenes/paper-section4.yaml");
   ASSERT_FALSE(paper.empty());
   auto with = [&](const std::vector<std::pair<std::string, std::string>>& lines) {
@@ -209,15 +205,14 @@ TEST(InterruptEvaluate, SigtermLeavesThePreviousResults) {
                                                         " --no-plots --quiet --out " + out);
   EXPECT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(files_in(out).size(), before.size());
-  fs::remove_all(dir);
 }
 
 // The FPGA flow interrupted during synthesis: the tool dies of the signal, yosys (started by
 // scripts/build_bitstream.sh, two processes down) stops with it, and no summary is left.
 TEST(InterruptBitstream, SigtermStopsTheFlowsCommands) {
   if (std::system("command -v yosys >/dev/null") != 0) GTEST_FAIL() << "yosys not installed";
-  const fs::path dir = fs::temp_directory_path() / ("ranging_int_bitstream_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_int_bitstream");
+  const fs::path dir = scratch.path();
   const std::string out = (dir / "out").string();
   const fs::path log = fs::path(out) / "yosys_ice40.log";
   const int status = run_and_signal_when(
@@ -243,7 +238,6 @@ TEST(InterruptBitstream, SigtermStopsTheFlowsCommands) {
   }
   EXPECT_EQ(left, "") << "processes of the interrupted flow still run";
   EXPECT_FALSE(fs::exists(fs::path(out) / "results" / "bitstream.json")) << "a summary of an interrupted flow";
-  fs::remove_all(dir);
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM),

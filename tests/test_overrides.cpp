@@ -11,6 +11,7 @@
 #include "model/config/receiver_config.hpp"
 #include "model/sim/scene.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 using namespace ranging;
 using testing_support::run_tool;
@@ -35,12 +36,6 @@ std::string slurp(const fs::path& p) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
-}
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("ranging_overrides_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(d);
-  return d;
 }
 
 }  // namespace
@@ -129,7 +124,8 @@ TEST(Overrides, ScenesTakeTheirOwnAndTheirConfigurationsKeys) {
 // The effective scene and configuration are written next to the results, and re-running them
 // reproduces the results exactly.
 TEST(Overrides, SimulateWritesTheEffectiveSceneAndItRepeatsTheRun) {
-  const fs::path a = fresh_dir("a"), b = fresh_dir("b");
+  const testing_support::ScratchDir scratch("ranging_overrides");
+  const fs::path a = scratch.path() / "a", b = scratch.path() / "b";
   const auto r1 = run_tool("simulate " + kSource + "/scenes/minimal.yaml --quiet --out " + a.string() +
                            " --set noise.noise_v=0.01 --set receiver.precision=fixed"
                            " --set receiver.config.correlator_fixed.chip_bits=18");
@@ -141,14 +137,14 @@ TEST(Overrides, SimulateWritesTheEffectiveSceneAndItRepeatsTheRun) {
   ASSERT_EQ(r2.status, 0) << r2.err;
   EXPECT_EQ(slurp(a / "measurements.csv"), slurp(b / "measurements.csv"));
   // The overrides changed the run (noise and precision): the plain scene gives other numbers.
-  const fs::path c = fresh_dir("c");
+  const fs::path c = scratch.path() / "c";
   ASSERT_EQ(run_tool("simulate " + kSource + "/scenes/minimal.yaml --quiet --out " + c.string()).status, 0);
   EXPECT_NE(slurp(a / "measurements.csv"), slurp(c / "measurements.csv"));
-  for (const auto& d : {a, b, c}) fs::remove_all(d);
 }
 
 TEST(Overrides, BadSetExitsTwoNamingItAndWritesNothing) {
-  const fs::path out = fresh_dir("bad");
+  const testing_support::ScratchDir scratch("ranging_overrides");
+  const fs::path out = scratch.path() / "bad";
   for (const std::string& cmd :
        {"simulate " + kSource + "/scenes/minimal.yaml --out " + out.string() + " --set noise.noise_v=abc",
         "simulate " + kSource + "/scenes/minimal.yaml --out " + out.string() + " --set noise.nosie_v=1",
@@ -163,11 +159,11 @@ TEST(Overrides, BadSetExitsTwoNamingItAndWritesNothing) {
 }
 
 TEST(Overrides, GenerateWritesTheEffectiveConfiguration) {
-  const fs::path out = fresh_dir("gen");
+  const testing_support::ScratchDir scratch("ranging_overrides");
+  const fs::path out = scratch.path() / "gen";
   const auto r = run_tool("generate --config " + kDefault + " --out " + out.string() + " --set filter.type=ellip --set filter.order=3");
   ASSERT_EQ(r.status, 0) << r.err;
   const ReceiverConfig c = load_receiver_config((out / "config.yaml").string());
   EXPECT_EQ(c.filter_type, FilterType::Elliptic);
   EXPECT_EQ(c.filter_order, 3);
-  fs::remove_all(out);
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace {
 
@@ -34,15 +35,9 @@ std::pair<unsigned, unsigned> png_size(const fs::path& p) {
   return {be32(16), be32(20)};
 }
 
-std::string temp_dir(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "/" + name + "_" + std::to_string(::getpid());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
 TEST(Plots, SimulateAndDecodeWritePngs) {
-  const std::string dir = temp_dir("plots");
+  const ranging::testing_support::ScratchDir scratch("plots", ::testing::TempDir());
+  const std::string dir = scratch.str();
   {
     std::ofstream(dir + "/s.yaml") << "name: plots\ntransducers: {}\ngeometry:\n  distances_m: [0.2, 0.6]\n"
                                       "excitation:\n  family: M1\n  codes: [2]\nnoise:\n  noise_v: 0.002\n  seed: 3\n";
@@ -60,11 +55,11 @@ TEST(Plots, SimulateAndDecodeWritePngs) {
   ASSERT_EQ(dec.status, 0) << dec.err;
   EXPECT_EQ(png_size(dir + "/dec.png"), std::make_pair(1000u, 800u));  // 10 x 8 in at 100 dpi
   EXPECT_FALSE(fs::exists(dir + "/dec.png.data.json"));
-  fs::remove_all(dir);
 }
 
 TEST(Plots, BadPlotPathsAreRefusedBeforeAnyWork) {
-  const std::string dir = temp_dir("plots_bad");
+  const ranging::testing_support::ScratchDir scratch("plots_bad", ::testing::TempDir());
+  const std::string dir = scratch.str();
   const std::string scene = std::string(RANGING_SOURCE_DIR) + "/scenes/minimal.yaml";
   auto r = run_tool("simulate " + scene + " --out " + dir + "/out --quiet --plot " + dir + "/error.txt");
   EXPECT_EQ(r.status, 2);
@@ -78,7 +73,6 @@ TEST(Plots, BadPlotPathsAreRefusedBeforeAnyWork) {
   r = run_tool("decode " + dir + "/missing.wav --family M1 --plot " + dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(r.out.empty()) << r.out;
-  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "model/config/receiver_config.hpp"
 #include "model/hw/realtime.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace fs = std::filesystem;
 using ranging::testing_support::run_tool;
@@ -66,8 +67,8 @@ TEST(RealTime, HalfTheDecimationOverrunsTheBackEnd) {
 }
 
 TEST(RealTime, LargeConfigurationIsMarkedNotRealTime) {
-  const fs::path out = fs::temp_directory_path() / ("ranging_realtime_" + std::to_string(::getpid()));
-  fs::remove_all(out);
+  const ranging::testing_support::ScratchDir scratch("ranging_realtime");
+  const fs::path out = scratch.path() / "out";  // made by generate
   const auto r = run_tool("generate --config " + kSource + "/configs/large.yaml --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("warning: NOT REAL TIME"), std::string::npos) << r.err;
@@ -82,7 +83,6 @@ TEST(RealTime, LargeConfigurationIsMarkedNotRealTime) {
   // The back end's FIR alone is 2 TAPS limb products: hundreds of clocks per sample.
   EXPECT_GT(rt.at("bank_back_end_clocks_per_group").get<long long>(), 2 * 500);
   EXPECT_GT(rt.at("clocks_per_sample_needed").get<double>(), 18.0);
-  fs::remove_all(out);
 }
 
 TEST(RealTime, DefaultManifestSaysRealTime) {
@@ -95,9 +95,8 @@ TEST(RealTime, DefaultManifestSaysRealTime) {
 // The sweep records the same verdict per point (cost.real_time, with the stage numbers) and the
 // stability guard's verdict.
 TEST(RealTime, SweepPointsCarryTheRuleAndTheStabilityVerdict) {
-  const fs::path dir = fs::temp_directory_path() / ("ranging_realtime_sweep_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_realtime_sweep");
+  const fs::path dir = scratch.path();
   std::ofstream(dir / "scene.yaml") << "name: tiny\ntransducers: {}\ngeometry:\n  distances_m: [0.3]\n"
                                        "excitation:\n  family: Gold4\n  codes: [1, 5]\n"
                                        "noise:\n  noise_v: 0.01\n  seed: 4\n";
@@ -126,5 +125,4 @@ TEST(RealTime, SweepPointsCarryTheRuleAndTheStabilityVerdict) {
     EXPECT_LT(s.at("max_quantized_pole_radius").get<double>(), 1.0);
     EXPECT_GT(s.at("max_quantized_pole_radius").get<double>(), 0.5);
   }
-  fs::remove_all(dir);
 }

@@ -20,6 +20,7 @@
 #include "model/sim/scene.hpp"
 #include "model/sim/scene_simulator.hpp"
 #include "process.hpp"
+#include "scratch.hpp"
 
 using namespace ranging;
 
@@ -380,9 +381,8 @@ TEST(FlatTopClipping, LevelsMergedFromPartsAreTheOneScansLevels) {
 TEST(SceneExtremesCli, SimulateAndDecodeReportClipping) {
   namespace fs = std::filesystem;
   using ranging::testing_support::run_tool;
-  const fs::path dir = fs::temp_directory_path() / ("ranging_extremes_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const testing_support::ScratchDir scratch("ranging_extremes");
+  const fs::path dir = scratch.path();
   {
     std::ofstream(dir / "clip.yaml") << "name: clip\ntransducers: {}\ngeometry:\n  distances_m: [0.02]\nexcitation:\n"
                                         "  family: Gold4\n  codes: [2]\n" << kAdc;
@@ -409,5 +409,4 @@ TEST(SceneExtremesCli, SimulateAndDecodeReportClipping) {
   const auto a = nlohmann::json::parse(amb.out);
   EXPECT_EQ(a["families"][0]["range_ambiguous"], 9);
   EXPECT_GE(a["decode_errors"].get<int>(), 9);
-  fs::remove_all(dir);
 }

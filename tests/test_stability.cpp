@@ -21,6 +21,7 @@
 #include "model/dsp/receiver.hpp"
 #include "model/dsp/stability.hpp"
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 namespace ranging {
 namespace {
@@ -29,8 +30,10 @@ namespace fs = std::filesystem;
 using testing_support::run_command;
 using testing_support::run_tool;
 
+// Files of every test in one directory, removed at exit.
 fs::path temp_path(const std::string& name) {
-  return fs::temp_directory_path() / ("ranging_stab_" + std::to_string(::getpid()) + "_" + name);
+  static const testing_support::ScratchDir scratch("ranging_stab");
+  return scratch.path() / name;
 }
 fs::path write_file(const std::string& name, const std::string& text) {
   const fs::path p = temp_path(name);

@@ -11,15 +11,15 @@
 #include <sstream>
 
 #include "tests/process.hpp"
+#include "tests/scratch.hpp"
 
 using nlohmann::json;
 using ranging::testing_support::run_tool;
 namespace fs = std::filesystem;
 
 TEST(SweepSynth, EqualRtlIsSynthesizedOnceAndResourcesAreReported) {
-  const fs::path dir = fs::temp_directory_path() / ("ranging_sweep_synth_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_sweep_synth");
+  const fs::path dir = scratch.path();
   std::ofstream(dir / "scene.yaml") << "transducers: {}\ngeometry:\n  distances_m: [0.5]\nexcitation:\n  family: Gold4\n"
                                        "  codes: [2]\nnoise:\n  noise_v: 0.01\n";
   std::ofstream(dir / "spec.yaml") << "name: synth\nconfig: " << RANGING_SOURCE_DIR
@@ -40,13 +40,11 @@ TEST(SweepSynth, EqualRtlIsSynthesizedOnceAndResourcesAreReported) {
   for (int i = 1; i < 3; ++i) EXPECT_EQ(doc["points"][i]["cost"]["ice40"], base);
   EXPECT_NE(doc["points"][3]["cost"]["ice40"]["rtl_hash"], base["rtl_hash"]);
   EXPECT_EQ(doc["cost_for_front"], "lut4");
-  fs::remove_all(dir);
 }
 
 TEST(SweepSynth, EcpAndXilinxEstimatesBesideTheIce40s) {
-  const fs::path dir = fs::temp_directory_path() / ("ranging_sweep_targets_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const ranging::testing_support::ScratchDir scratch("ranging_sweep_targets");
+  const fs::path dir = scratch.path();
   std::ofstream(dir / "scene.yaml") << "transducers: {}\ngeometry:\n  distances_m: [0.5]\nexcitation:\n  family: Gold4\n"
                                        "  codes: [2]\nnoise:\n  noise_v: 0.01\n";
   std::ofstream(dir / "spec.yaml") << "name: targets\nconfig: " << RANGING_SOURCE_DIR
@@ -67,5 +65,4 @@ TEST(SweepSynth, EcpAndXilinxEstimatesBesideTheIce40s) {
   std::getline(csv, header);
   EXPECT_NE(header.find("ecp5_mult18"), std::string::npos) << header;
   EXPECT_NE(header.find("xilinx_dsp48"), std::string::npos) << header;
-  fs::remove_all(dir);
 }
