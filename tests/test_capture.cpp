@@ -305,6 +305,24 @@ TEST(DecodeCli, BadCapturesExitTwoWithAClearMessageAndNoOutput) {
   const ToolRun r = run_tool("decode " + dir + "/odd.csv --family M1");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("integer >= 4"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; the nearest are 4.8 and 5 MS/s"), std::string::npos) << r.err;
+  // every example rate the message gives is one the receiver takes (it once offered 2.5 MS/s,
+  // 12.5 samples per cycle)
+  const auto eg = r.err.find("(e.g. "), end = r.err.find(" MS/s)", eg);
+  ASSERT_NE(eg, std::string::npos) << r.err;
+  ASSERT_NE(end, std::string::npos) << r.err;
+  std::string list = r.err.substr(eg + 6, end - eg - 6);
+  for (auto& ch : list) ch = (ch == ',' ? ' ' : ch);
+  std::istringstream words(list);
+  int examples = 0;
+  for (std::string w; words >> w;) {
+    if (w == "or") continue;
+    const double per_cycle = std::stod(w) * 1e6 / 200e3;
+    EXPECT_EQ(per_cycle, std::round(per_cycle)) << w << " MS/s in: " << r.err;
+    EXPECT_GE(per_cycle, 4.0) << w << " MS/s in: " << r.err;
+    ++examples;
+  }
+  EXPECT_GE(examples, 3) << r.err;
 }
 
 // Captures carry their metadata (issue 14, section 5): decode uses it unless an option

@@ -252,7 +252,14 @@ int cmd_decode(const Args& args) {
     if (std::abs(ratio - std::round(ratio)) > 1e-3 * ratio || std::round(ratio) < 4) {
       std::ostringstream os;
       os << file << ": sample rate " << rate << " Hz is " << ratio
-         << " samples per 200 kHz carrier cycle; the receiver needs an integer >= 4 (e.g. 1, 2.5, 4, 5 or 10 MS/s)";
+         << " samples per 200 kHz carrier cycle; the receiver needs an integer >= 4 (e.g. 1, 2, 4, 5 or 10 MS/s)";
+      // the nearest rates it takes, to resample the capture to
+      const double lo = std::max(std::floor(ratio), 4.0), hi = std::max(std::ceil(ratio), 4.0);
+      if (lo == hi) {
+        os << "; the nearest is " << lo * carrier / 1e6 << " MS/s";
+      } else {
+        os << "; the nearest are " << lo * carrier / 1e6 << " and " << hi * carrier / 1e6 << " MS/s";
+      }
       if (rate < 1e5 && file.size() >= 4 && file.compare(file.size() - 4, 4, ".csv") == 0) {
         os << " (a CSV's first column is the time in seconds)";
       }
