@@ -75,11 +75,14 @@
 //   Limb products per output at the defaults (DEC_W 23, TAP_W 16, CORR_W 16, TAPS 20,
 //     CODES 9): FIR 2*20*2 = 80 (+ 1 priming clock), SQ 9*2 = 18, W 9*2 = 18: 117 <= 120 = 6
 //     DECIM clocks.
-// Throughput: 6 clocks per input sample when the back end keeps up, i.e. when
-//   2 TAPS ceil(DEC_W/16) ceil(TAP_W/16) + CODES (2 ceil(CORR_W/16)^2 + ceil(2 CORR_W/16)
-//   ceil(WEIGHT_W/16)) <= 6 DECIM (plus a few clocks of pipeline slack); otherwise the back
-//   end sets the pace (the front end waits at a decimation point). 6 clocks at the defaults
-//   (tested: one input every 6 clocks is never refused).
+// Throughput: 6 clocks per input sample when the back end keeps up, i.e. when both its
+//   multiplier, 2 TAPS ceil(DEC_W/16) ceil(TAP_W/16) + CODES (2 ceil(CORR_W/16)^2 +
+//   ceil(2 CORR_W/16) ceil(WEIGHT_W/16)), and its combiner, (CHIPS + 2) CODES, take
+//   <= 6 DECIM clocks per output (plus a few clocks of pipeline slack; model/hw/realtime.hpp);
+//   otherwise the back end sets the pace (the front end waits at a decimation point). 6
+//   clocks at the defaults (117 and 81 <= 120; tested: one input every 6 clocks is never
+//   refused). A 15-chip family of 15 codes needs 255 combiner clocks per output: DECIM >= 50
+//   at 6 clocks per sample (`ranging verify` checks the rule against the paced RTL).
 // Latency: last input of a decimation group to the group's first beat: about 2 TAPS
 //   ceil(DEC_W/16) ceil(TAP_W/16) + 5 (FIR) + (CHIPS+2) CODES + 8 clocks when idle (~175
 //   at the defaults), more when the previous output's SQ/W work overlaps; the last beat

@@ -1,6 +1,6 @@
 // The real-time budget (model/hw/realtime.hpp, issue 17 section 7): the rule reproduces the
 // figures the RTL headers state and tb_peak_detector measured at the default configuration
-// (bank back end 117 <= 120 clocks per group, detector 101 < 120), refuses a clock below the
+// (bank back end 117 <= 120 clocks per group, combiner 81, detector 101 < 120), refuses a clock below the
 // bandpass's 6 clocks per sample, and marks configs/large.yaml (DECIM 1, 524 taps at 5 MS/s)
 // "NOT REAL TIME" in manifest.json with the numbers, warning on stderr.
 #include <gtest/gtest.h>
@@ -38,6 +38,8 @@ TEST(RealTime, DefaultMatchesTheRtlHeaders) {
   EXPECT_EQ(r.group_clocks, 120);
   // rtl/correlator_bank.v: FIR 2*20*2 = 80 + 1, SQ 9*2, W 9*2: 117 <= 120.
   EXPECT_EQ(r.bank_back_end_clocks, 117);
+  // rtl/correlator_bank.v: the combiner, (CHIPS + 2) CODES = 9 x 9 = 81 <= 120.
+  EXPECT_EQ(r.combiner_clocks, 81);
   // rtl/peak_detector.v: <= 101 clocks per group (101 measured on the edge-case stream).
   EXPECT_EQ(r.detector_clocks, 101);
   EXPECT_TRUE(r.real_time) << r.summary();
@@ -64,6 +66,24 @@ TEST(RealTime, HalfTheDecimationOverrunsTheBackEnd) {
   EXPECT_GT(r.bank_back_end_clocks, 60);
   EXPECT_GT(r.detector_clocks, 60);
   EXPECT_GT(r.needed_clocks_per_sample(), 6.0);
+}
+
+// The combiner runs one round of CHIPS + 2 clocks per code for every output group, on its own
+// engine: M3 (15 chips, 15 codes) needs 255 clocks per group. At DECIM 25 (150 clocks) the
+// multiplier's back end (125) and the detector fit, and the rule used to say "real time" while
+// the RTL fell behind one sample in six (ranging verify: 44074 of 44205 paced samples late).
+TEST(RealTime, ALongFamilyOverrunsTheCombiner) {
+  const auto r = budget("default.yaml", {{"family", "M3"}, {"correlator.decimation", "25"}});
+  EXPECT_EQ(r.group_clocks, 150);
+  EXPECT_LE(r.bank_back_end_clocks, 150);
+  EXPECT_LE(r.detector_clocks, 150);
+  EXPECT_EQ(r.combiner_clocks, (15 + 2) * 15);
+  EXPECT_FALSE(r.real_time) << r.summary();
+  ASSERT_EQ(r.limits.size(), 1u) << r.summary();
+  EXPECT_NE(r.limits[0].find("combiner needs 255 > 150"), std::string::npos) << r.limits[0];
+  EXPECT_DOUBLE_EQ(r.needed_clocks_per_sample(), 255.0 / 25);
+  // DECIM 50 (300 clocks per group) gives it room
+  EXPECT_TRUE(budget("default.yaml", {{"family", "M3"}, {"correlator.decimation", "50"}}).real_time);
 }
 
 TEST(RealTime, LargeConfigurationIsMarkedNotRealTime) {
@@ -116,6 +136,7 @@ TEST(RealTime, SweepPointsCarryTheRuleAndTheStabilityVerdict) {
     EXPECT_EQ(c.at("real_time").get<bool>(), expect.real_time);
     EXPECT_EQ(c.at("real_time").get<bool>(), base);
     EXPECT_EQ(c.at("bank_back_end_clocks_per_group").get<long long>(), expect.bank_back_end_clocks);
+    EXPECT_EQ(c.at("combiner_clocks_per_group").get<long long>(), expect.combiner_clocks);
     EXPECT_EQ(c.at("detector_clocks_per_group").get<long long>(), expect.detector_clocks);
     EXPECT_EQ(c.at("clocks_per_sample_available").get<long long>(), base ? 6 : 4);
     EXPECT_EQ(c.at("real_time_summary").get<std::string>(), expect.summary());

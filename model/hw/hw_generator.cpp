@@ -63,6 +63,7 @@ std::string manifest(const ReceiverDesign& d, const std::vector<HwModuleParams>&
                     {"clocks_per_sample_needed", rt.needed_clocks_per_sample()},
                     {"group_clocks", rt.group_clocks},
                     {"bank_back_end_clocks_per_group", rt.bank_back_end_clocks},
+                    {"combiner_clocks_per_group", rt.combiner_clocks},
                     {"detector_clocks_per_group", rt.detector_clocks},
                     {"summary", rt.summary()}};
   for (const auto& m : mods) {

@@ -357,19 +357,20 @@ json synthesize(const std::map<std::string, std::string>& files, const PointOpti
   return j;
 }
 
-// The design's own throughput rule (model/hw/realtime.hpp: bandpass, bank back end and peak
-// detector against clock_hz / fs).
+// The design's own throughput rule (model/hw/realtime.hpp: bandpass, bank back end, combiner
+// and peak detector against clock_hz / fs).
 json throughput(const ReceiverDesign& d) {
   const RealTimeBudget r = realtime_budget(d);
   return json{{"clocks_per_sample_available", r.clocks_per_sample},
               {"clocks_per_sample_needed", r.needed_clocks_per_sample()},
               {"bank_back_end_clocks_per_group", r.bank_back_end_clocks},
+              {"combiner_clocks_per_group", r.combiner_clocks},
               {"detector_clocks_per_group", r.detector_clocks},
               {"group_clocks", r.group_clocks},
               {"decimation", r.decimation},
               {"real_time", r.real_time},
               {"real_time_summary", r.summary()},
-              {"rule", "model/hw/realtime.hpp: 6 <= clock_hz / fs, bank back end and peak detector <= DECIM clock_hz / fs per group"}};
+              {"rule", "model/hw/realtime.hpp: 6 <= clock_hz / fs, bank back end, combiner and peak detector <= DECIM clock_hz / fs per group"}};
 }
 
 long long word_bits(const ReceiverConfig& c) {
@@ -641,7 +642,8 @@ std::string points_csv(const std::vector<json>& points) {
                                         "distance_rmse_m", "max_abs_error_m", "tof_max_deviation_from_float_s",
                                         "float_disagreements", "u_min", "overflows"};
   const std::vector<std::string> cost = {"clocks_per_sample_needed", "clocks_per_sample_available",
-                                         "bank_back_end_clocks_per_group", "detector_clocks_per_group",
+                                         "bank_back_end_clocks_per_group", "combiner_clocks_per_group",
+                                         "detector_clocks_per_group",
                                          "group_clocks", "real_time", "word_bits"};
   // Synthesis columns: every field of every target some point was synthesized for.
   std::vector<std::pair<std::string, std::string>> syn_cols;
