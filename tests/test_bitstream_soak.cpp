@@ -59,4 +59,20 @@ TEST(BitstreamSoak, UserConfigurationPlacedAndRoutedWithParallelSeeds) {
   EXPECT_GT(fs::file_size(dir + "/ranging_icebreaker.bin"), 100000u);
 }
 
+// A configuration the iCE40UP5K cannot hold (an elliptic bandpass: 4813 LUT4 and 5867 logic
+// cells of 5280) is no bitstream: exit 1 with the reason on stderr, also without --check (it
+// used to exit 0, "built", after nextpnr failed).
+TEST(BitstreamSoak, ADesignThatDoesNotFitIsNoBitstream) {
+  if (std::system("command -v nextpnr-ice40 >/dev/null") != 0) GTEST_FAIL() << "nextpnr-ice40 not installed";
+  const ranging::testing_support::ScratchDir scratch("bitstream_nofit", ::testing::TempDir());
+  const std::string dir = scratch.file("out");
+  const auto r = ranging::testing_support::run_tool("bitstream --config " + std::string(RANGING_SOURCE_DIR) +
+                                                    "/configs/default.yaml --set filter.type=ellip --out " + dir);
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("no bitstream: the design did not place and route"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(std::ifstream(dir + "/results/bitstream.json"));
+  EXPECT_FALSE(j["ice40"]["placed_and_routed"].get<bool>());
+  EXPECT_FALSE(fs::exists(dir + "/ranging_icebreaker.bin"));
+}
+
 }  // namespace

@@ -212,6 +212,14 @@ int cmd_bitstream(const Args& args) {
     throw InputError("option --program: the design was not placed and routed (" +
                      ic.value("nextpnr_error", std::string("nextpnr failed")) + "): nothing to program");
   }
+  // Placed and routed, but slower than the clock it must run at: the board would compute wrong
+  // results, so it is neither programmed nor reported as built.
+  const double fmax = ic.value("fmax_mhz", 0.0), required = ic.value("required_clock_mhz", 0.0);
+  const bool too_slow = routed && fmax < required;
+  if (do_program && too_slow) {
+    throw InputError("option --program: the design reaches Fmax " + std::to_string(fmax) + " MHz, below its " +
+                     std::to_string(required) + " MHz clock: not programmed");
+  }
   const fs::path bin = out / "ranging_icebreaker.bin";
   if (do_program) program(prog, bin.string());
   std::cout << "configuration " << cfg.name << " (" << config << "), board " << board << "\n"
@@ -233,6 +241,17 @@ int cmd_bitstream(const Args& args) {
     std::cout << "not placed and routed: " << ic.value("nextpnr_error", std::string("nextpnr failed")) << "\n";
   }
   std::cout << "targets " << (met ? "met" : "not met") << "; summary " << (results / "bitstream.md").string() << "\n";
+  if (!routed) {
+    std::cerr << "ranging bitstream: no bitstream: the design did not place and route on the iCE40UP5K (LUT4 "
+              << ic.value("lut4", 0) << " / 5280; " << ic.value("nextpnr_error", std::string("nextpnr failed"))
+              << ")\n";
+    return 1;
+  }
+  if (too_slow) {
+    std::cerr << "ranging bitstream: the bitstream does not run at its clock: Fmax " << fmax << " MHz < "
+              << required << " MHz required\n";
+    return 1;
+  }
   if (do_program) std::cout << "programmed with " << prog.name << "\n";
   return 0;
 }

@@ -95,8 +95,9 @@ constexpr Command kCommands[] = {
      "icetime: scripts/build_bitstream.sh), and optionally program the board. The netlists,\n"
      "logs, the .bin and the summary (results/bitstream.json and .md) go into --out; progress\n"
      "goes to stderr, the summary to stdout.\n"
-     "Exit status: 0 built (and programmed), 1 --check and a target missed, 2 bad input, a\n"
-     "missing tool, or --program with no programmer installed or no board attached (checked\n"
+     "Exit status: 0 built (and programmed); 1 no usable bitstream (the design did not place\n"
+     "and route, or its Fmax is below the clock), or --check and a target missed; 2 bad input,\n"
+     "a missing tool, or --program with no programmer installed or no board attached (checked\n"
      "before anything is built)."},
 };
 
