@@ -6,6 +6,7 @@ set -euo pipefail
 
 packages=(build-essential cmake g++ libgtest-dev libgmock-dev libbenchmark-dev libsystemc-dev
           nlohmann-json3-dev libyaml-cpp-dev libfftw3-dev libboost-dev pkg-config python3 python3-numpy python3-scipy
+          libtbb-dev  # oneTBB: the persistent worker threads of parallel_items (model/base/parallel.hpp)
           python3-matplotlib
           parallel  # the GNU parallel sweep recipe and its test (docs/design-space.md)
           clang libclang-rt-14-dev)  # clang + libFuzzer: tests/fuzz (RANGING_FUZZ=ON)
