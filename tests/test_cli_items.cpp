@@ -22,7 +22,9 @@ namespace {
 std::string tool_version() {
   const auto r = run_tool("--version");
   std::smatch m;
-  static const std::regex re("^ranging ([0-9]+\\.[0-9]+\\.[0-9]+) \\(git ([0-9a-f]{7,40}|unknown)\\)\n$");
+  // the commit of the build, "-dirty" when tracked files had changes (tool/git_commit.cmake)
+  static const std::regex re(
+      "^ranging ([0-9]+\\.[0-9]+\\.[0-9]+) \\(git ([0-9a-f]{7,40}(-dirty|-unknown-state)?|unknown)\\)\n$");
   if (r.status != 0 || !std::regex_match(r.out, m, re)) return "";
   return m[1];
 }
