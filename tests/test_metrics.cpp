@@ -229,6 +229,29 @@ TEST(PearsonOverLags, FftBankEqualsTheDirectDefinition) {
   EXPECT_EQ(bank.search(flat, 0, 600)[0].rho, 0.0);
 }
 
+// A bank told the largest lag span (max_lags) runs every search of up to that many lags on that
+// span's transform size, zero-padding the shorter windows at the signal's edges: the result is
+// still the direct definition's, and a search of more lags than max_lags gets its own size.
+TEST(PearsonOverLags, OneTransformSizeForEveryWindowEqualsTheDirectDefinition) {
+  std::vector<std::vector<double>> ts;
+  for (std::uint64_t j = 0; j < 3; ++j) ts.push_back(random_signal(300, 20 + j));
+  auto x = random_signal(1500, 98);
+  for (std::size_t i = 0; i < 300; ++i) x[40 + i] += 3.0 * ts[1][i];
+  PearsonBank fixed(ts, 401), own(ts);
+  // full span, both edges cut short, a narrow span, and more lags than max_lags
+  for (auto [lo, hi] : {std::pair<long, long>{500, 900}, {-200, 200}, {1000, 1400}, {30, 50}, {0, 1200}}) {
+    const auto b = fixed.search(x, lo, hi);
+    const auto c = own.search(x, lo, hi);
+    for (std::size_t j = 0; j < ts.size(); ++j) {
+      const LagRho d = pearson_over_lags(x, ts[j], lo, hi);
+      EXPECT_NEAR(b[j].rho, d.rho, 1e-12) << j << " [" << lo << "," << hi << "]";
+      EXPECT_EQ(b[j].lag, d.lag) << j << " [" << lo << "," << hi << "]";
+      EXPECT_NEAR(b[j].rho, c[j].rho, 1e-12) << j << " [" << lo << "," << hi << "]";
+    }
+  }
+  EXPECT_EQ(fixed.search(x, -200, 200)[1].lag, 40);
+}
+
 // The bank screens the lags by out/den before it divides (metrics.cpp): its result must be the
 // plain loop's (every lag's rho, the first of the largest) bit for bit, also where that rule is
 // delicate: the template repeated (rho about 1 at several lags, some clamped at 1), flat windows

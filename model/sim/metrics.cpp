@@ -66,7 +66,7 @@ struct PearsonBank::Plan {
   }
 };
 
-PearsonBank::PearsonBank(std::vector<std::vector<double>> templates) {
+PearsonBank::PearsonBank(std::vector<std::vector<double>> templates, std::size_t max_lags) : max_lags_(max_lags) {
   if (templates.empty()) throw InputError("PearsonBank: no references");
   n_ = templates.front().size();
   if (n_ < 2) throw InputError("PearsonBank: references have " + std::to_string(n_) + " samples; need >= 2");
@@ -333,8 +333,10 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   const auto [a, b] = valid_lags(x.size(), n_, lo, hi);
   const std::size_t lags = static_cast<std::size_t>(b - a) + 1;
   const std::size_t w = lags + n_ - 1;  // window x[a, b + N)
-  // any size >= w holds the lags' circular correlation without wrap: the next fast size
-  const std::size_t nfft = std::max<std::size_t>(64, correlation_fft_size(w));
+  // any size >= w holds the lags' circular correlation without wrap: the next fast size (of the
+  // bank's max_lags window when this one is shorter: one plan for every window of a stream)
+  const std::size_t w_size = lags <= max_lags_ ? max_lags_ + n_ - 1 : w;
+  const std::size_t nfft = std::max<std::size_t>(64, correlation_fft_size(w_size));
   Plan& p = plan(nfft);
   const double* xw = x.data() + a;
   // Segment sums of (x - mean) and its square by prefix sums; x - mean is the transform's input.

@@ -40,10 +40,14 @@ LagRho pearson_over_lags(std::span<const double> x, std::span<const double> t, l
 // come from prefix sums of x minus the window's mean. A segment whose variance is below 1e-24
 // of the window's largest gives rho 0 there (as pearson() does for zero variance).
 // Not thread-safe per object (it owns FFTW buffers); plans are made once per transform size.
+// max_lags > 0: every search of at most max_lags lags uses the transform size of max_lags lags
+// (a window cut short at the signal's edge is zero-padded to it), so a stream's bursts need one
+// FFTW plan, not one more per edge window (FFTW_ESTIMATE planning costs 2-6 ms per new size);
+// rho is the same to a few ulps as on the window's own size.
 class PearsonBank {
  public:
   // InputError if templates is empty, their lengths differ, or are < 2.
-  explicit PearsonBank(std::vector<std::vector<double>> templates);
+  explicit PearsonBank(std::vector<std::vector<double>> templates, std::size_t max_lags = 0);
   ~PearsonBank();
   PearsonBank(const PearsonBank&) = delete;
   PearsonBank& operator=(const PearsonBank&) = delete;
@@ -59,6 +63,7 @@ class PearsonBank {
   struct Plan;
   Plan& plan(std::size_t nfft);
   std::size_t n_ = 0;
+  std::size_t max_lags_ = 0;
   bool screen_ = true;
   std::vector<std::vector<double>> t_;  // centred templates
   std::vector<double> tnorm_;           // sqrt(sum tc^2)

@@ -492,8 +492,11 @@ struct SceneSimulator::Link {
       check_references_dir();
       for (std::size_t j = 0; j < eta; ++j) templates[j] = load_reference(static_cast<int>(j) + 1);
     }
-    bank = std::make_unique<PearsonBank>(templates);
+    bank = std::make_unique<PearsonBank>(templates, max_lags());
   }
+  // The Pearson search's lags per burst: +-L chips (metrics_window's reach), so every burst's
+  // search, edge windows too, runs on one transform size (PearsonBank's max_lags).
+  std::size_t max_lags() const { return static_cast<std::size_t>(2 * L * spc + 1); }
 
   // The references folder itself, once: a file or a missing path is named as such.
   void check_references_dir() const {
@@ -1074,7 +1077,7 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   std::vector<std::unique_ptr<PearsonBank>> banks;
   std::vector<std::unique_ptr<Link::Batches>> rbs;
   for (std::size_t k = 0; k < jobs; ++k) {
-    banks.push_back(k == 0 ? nullptr : std::make_unique<PearsonBank>(lk.templates));
+    banks.push_back(k == 0 ? nullptr : std::make_unique<PearsonBank>(lk.templates, lk.max_lags()));
     if (batched) rbs.push_back(std::make_unique<Link::Batches>(lk.design));
   }
   // Units per round (a round's results are held, then emitted in order): several per thread,
@@ -1221,7 +1224,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     // jobs_ - 1 more matched-filter banks for the worker threads (this thread uses lk.bank)
     std::vector<std::unique_ptr<PearsonBank>> banks;
     if (scene_.receiver.metrics.pearson) {
-      for (int t = 1; t < jobs_; ++t) banks.push_back(std::make_unique<PearsonBank>(lk.templates));
+      for (int t = 1; t < jobs_; ++t) banks.push_back(std::make_unique<PearsonBank>(lk.templates, lk.max_lags()));
     }
     // Burst i's metrics on window wr, on worker thread t (thread 0 uses lk.bank; without Pearson
     // outputs no bank is used and banks is empty); false: its T_d search needs more samples.
