@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "model/base/error.hpp"
+#include "model/base/memo.hpp"
 #include "model/base/names.hpp"
 
 namespace ranging {
@@ -481,13 +482,21 @@ std::complex<double> zpk_response(const Zpk& zpk, double f, double fs) {
 }
 
 SosFilter design_bandpass(const BandpassSpec& spec, FilterType type, int order) {
-  const Zpk d = design_bandpass_zpk(spec, type, order);
-  SosFilter f;
-  f.type = type;
-  f.order = order;
-  f.fs = spec.fs;
-  f.sections = zpk_to_sections(d, spec.fs);
-  return f;
+  // Pure and deterministic, and asked twice per run (scene loading checks the design, the
+  // receiver builds it): kept by its arguments (model/base/memo.hpp), about 2 ms each.
+  static Memo<SosFilter> memo;
+  MemoKey key;
+  key.add(spec.fp1).add(spec.fp2).add(spec.fs1).add(spec.fs2).add(spec.rp_db).add(spec.rs_db).add(spec.fs);
+  key.add(type).add(order);
+  return memo.get(key, [&] {
+    const Zpk d = design_bandpass_zpk(spec, type, order);
+    SosFilter f;
+    f.type = type;
+    f.order = order;
+    f.fs = spec.fs;
+    f.sections = zpk_to_sections(d, spec.fs);
+    return f;
+  });
 }
 
 SosFilter design_bandpass(const BandpassSpec& spec, FilterType type) {
