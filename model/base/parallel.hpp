@@ -11,6 +11,7 @@
 // std::thread per call cost a clone, an 8 MB stack and its page faults each time). Each worker
 // takes its index t once, so per-thread state is never shared, also when a worker waits in a
 // nested call.
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <exception>
@@ -19,19 +20,26 @@
 #include <mutex>
 #include <vector>
 
+#include <oneapi/tbb/info.h>
 #include <oneapi/tbb/task_arena.h>
 #include <oneapi/tbb/task_group.h>
 
 namespace ranging {
 
 namespace detail {
-// One arena per worker count, made on first use and kept (arenas are meant to live long).
+// One arena per worker count, made on first use and kept (arenas are meant to live long). It
+// has at most as many slots as the machine has threads (TBB's default concurrency: more slots
+// than TBB has threads only made it print a warning); workers beyond that run as tasks on the
+// threads there are, each still with its own index t.
 inline tbb::task_arena& parallel_arena(std::size_t threads) {
   static std::mutex m;
   static std::map<std::size_t, std::unique_ptr<tbb::task_arena>> arenas;
   const std::lock_guard<std::mutex> lock(m);
   auto& a = arenas[threads];
-  if (!a) a = std::make_unique<tbb::task_arena>(static_cast<int>(threads));
+  if (!a) {
+    const auto slots = std::min<std::size_t>(threads, static_cast<std::size_t>(std::max(1, tbb::info::default_concurrency())));
+    a = std::make_unique<tbb::task_arena>(static_cast<int>(slots));
+  }
   return *a;
 }
 }  // namespace detail
