@@ -87,6 +87,21 @@ TEST(DecodeSchedule, BurstsArrivingBeforeTheirCodesFirstSendHaveNoDistance) {
   EXPECT_EQ(t.out.find("   87."), std::string::npos) << t.out;  // the old distance of code 7's echo, mm
 }
 
+// More workers than the machine has threads (--jobs 256): the same output as one, and nothing
+// from the thread library on stderr (an arena wider than TBB's threads printed "TBB Warning").
+TEST(DecodeSchedule, ManyMoreJobsThanCoresGiveTheSameOutputQuietly) {
+  const ScratchDir dir("decode_jobs", ::testing::TempDir());
+  const std::string wav = cut_train(dir, 1);
+  const std::string args = "decode " + wav + " --family Gold4 --period 0.0004 --speed-of-sound 343.987 --json";
+  const auto one = run_tool(args + " --jobs 1");
+  const auto many = run_tool(args + " --jobs 256");
+  ASSERT_EQ(one.status, 0) << one.err;
+  ASSERT_EQ(many.status, 0) << many.err;
+  EXPECT_EQ(many.out, one.out);
+  EXPECT_EQ(many.err.find("TBB"), std::string::npos) << many.err;
+  EXPECT_EQ(many.err, one.err);
+}
+
 // Latency calibration takes its ToF from detections with a send before them only.
 TEST(DecodeSchedule, CalibrationLeavesOutDetectionsWithoutASendBeforeThem) {
   Detection early, ok;
