@@ -9,7 +9,6 @@
 // model/dsp/stability.cpp).
 //   MemoKey k; k.add(spec.fs).add(order);  Memo<SosFilter> m;  m.get(k, [&] { return design(); });
 #include <cstddef>
-#include <cstring>
 #include <map>
 #include <mutex>
 #include <string>
@@ -18,7 +17,8 @@
 
 namespace ranging {
 
-// The arguments' bytes (trivially copyable values and vectors of them, in order).
+// The arguments' bytes (trivially copyable values without padding bytes, e.g. structs of
+// doubles, and vectors of them, in order).
 class MemoKey {
  public:
   template <class T>

@@ -486,8 +486,7 @@ SosFilter design_bandpass(const BandpassSpec& spec, FilterType type, int order) 
   // receiver builds it): kept by its arguments (model/base/memo.hpp), about 2 ms each.
   static Memo<SosFilter> memo;
   MemoKey key;
-  key.add(spec.fp1).add(spec.fp2).add(spec.fs1).add(spec.fs2).add(spec.rp_db).add(spec.rs_db).add(spec.fs);
-  key.add(type).add(order);
+  key.add(spec).add(type).add(order);
   return memo.get(key, [&] {
     const Zpk d = design_bandpass_zpk(spec, type, order);
     SosFilter f;

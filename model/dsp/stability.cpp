@@ -155,25 +155,6 @@ double DesignGuard::max_quantized_radius() const {
 
 namespace {
 DesignGuard check_quantized_design_uncached(const SosFilter& filter, const QuantizedSos& q, const BandpassSpec& spec,
-                                            int coef_bits, double tolerance_db);
-}  // namespace
-
-// Pure and deterministic, and asked twice per run (scene loading, then the receiver's design):
-// kept by its arguments (model/base/memo.hpp); the check's node gains and responses cost ms.
-DesignGuard check_quantized_design(const SosFilter& filter, const QuantizedSos& q, const BandpassSpec& spec,
-                                   int coef_bits, double tolerance_db) {
-  static Memo<DesignGuard> memo;
-  MemoKey key;
-  key.add(filter.type).add(filter.order).add(filter.fs).add(filter.sections);
-  key.add(q.frac).add(q.sections.size());
-  for (const auto& sec : q.sections) key.add(sec);
-  key.add(spec.fp1).add(spec.fp2).add(spec.fs1).add(spec.fs2).add(spec.rp_db).add(spec.rs_db).add(spec.fs);
-  key.add(coef_bits).add(tolerance_db);
-  return memo.get(key, [&] { return check_quantized_design_uncached(filter, q, spec, coef_bits, tolerance_db); });
-}
-
-namespace {
-DesignGuard check_quantized_design_uncached(const SosFilter& filter, const QuantizedSos& q, const BandpassSpec& spec,
                                             int coef_bits, double tolerance_db) {
   if (q.sections.size() != filter.sections.size()) {
     throw InputError("stability guard: " + std::to_string(q.sections.size()) + " quantized sections for " +
@@ -227,6 +208,18 @@ DesignGuard check_quantized_design_uncached(const SosFilter& filter, const Quant
 }
 
 }  // namespace
+
+// Pure and deterministic, and asked twice per run (scene loading, then the receiver's design):
+// kept by its arguments (model/base/memo.hpp); the check's node gains and responses cost ms.
+DesignGuard check_quantized_design(const SosFilter& filter, const QuantizedSos& q, const BandpassSpec& spec,
+                                   int coef_bits, double tolerance_db) {
+  static Memo<DesignGuard> memo;
+  MemoKey key;
+  key.add(filter.type).add(filter.order).add(filter.fs).add(filter.sections);
+  key.add(q.frac).add(q.sections);
+  key.add(spec).add(coef_bits).add(tolerance_db);
+  return memo.get(key, [&] { return check_quantized_design_uncached(filter, q, spec, coef_bits, tolerance_db); });
+}
 
 DesignGuard check_quantized_design(const ReceiverConfig& cfg_in) {
   BandpassSpec spec = cfg_in.filter;
