@@ -3,10 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <mutex>
 #include <random>
 #include <thread>
 #include <vector>
 
+#include "model/base/aligned.hpp"
 #include "model/base/error.hpp"
 #include "model/sim/fft.hpp"
 
@@ -111,4 +114,61 @@ TEST(FftSize, CorrelationSizeIsTheSmallestTwoThreeOrFiveTimesAPowerOfTwo) {
   }
   EXPECT_EQ(correlation_fft_size(2400), 2560u);  // the decode's Gold Pearson window
   for (std::size_t n : {16385u, 25000u, 307000u}) EXPECT_EQ(correlation_fft_size(n), fft_size(n)) << n;
+}
+
+// plan_correlation: the wisdom's measured plans for every size PearsonBank can ask for when the
+// wisdom imports here (and estimates otherwise), each computing the circular correlation
+// PearsonBank needs; the wisdom is gone after, so the process's other plans (convolve's) are
+// the ones they were before, bit for bit.
+TEST(CorrelationPlans, EverySizeIsPlannedAndCorrelatesAndOtherPlansDoNotChange) {
+  std::mt19937_64 rng(7);
+  // convolve() sizes the wisdom also covers (its transforms: 1024, 2048, 4096 points)
+  std::vector<std::pair<std::vector<double>, std::vector<double>>> ops;
+  for (std::size_t n : {700u, 1500u, 3000u}) ops.emplace_back(random_vector(n, rng), random_vector(300, rng));
+  std::vector<std::vector<double>> before;
+  for (const auto& [a, b] : ops) before.push_back(convolve(a, b));
+
+  const bool applies = correlation_wisdom_applies();
+  std::vector<std::size_t> sizes;
+  for (std::size_t n = 1; n <= kCorrelationWisdomPoints; ++n) {
+    const std::size_t s = std::max<std::size_t>(64, correlation_fft_size(n));
+    if (sizes.empty() || sizes.back() != s) sizes.push_back(s);
+  }
+  EXPECT_EQ(sizes.front(), 64u);
+  EXPECT_EQ(sizes.back(), kCorrelationWisdomPoints);
+  for (std::size_t nfft : sizes) {
+    const std::size_t nc = nfft / 2 + 1;
+    AlignedVector<double> in(nfft), out(nfft);  // as PearsonBank's (the wisdom's alignment)
+    AlignedVector<std::complex<double>> spec(nc), prod(nc);
+    auto* sp = reinterpret_cast<fftw_complex*>(spec.data());
+    auto* pp = reinterpret_cast<fftw_complex*>(prod.data());
+    const CorrelationPlans p = plan_correlation(nfft, in.data(), sp, pp, out.data());
+    ASSERT_NE(p.fwd, nullptr);
+    ASSERT_NE(p.inv, nullptr);
+    EXPECT_EQ(p.measured, applies) << nfft;
+    // x . t over the first lags (no wrap: t is short), against the plain sum
+    const std::size_t nt = std::min<std::size_t>(32, nfft / 4);
+    const auto x = random_vector(nfft - nt, rng), t = random_vector(nt, rng);
+    std::fill(in.begin(), in.end(), 0.0);
+    std::copy(t.begin(), t.end(), in.begin());
+    fftw_execute(p.fwd);
+    const AlignedVector<std::complex<double>> tspec = spec;
+    std::fill(in.begin(), in.end(), 0.0);
+    std::copy(x.begin(), x.end(), in.begin());
+    fftw_execute(p.fwd);
+    for (std::size_t k = 0; k < nc; ++k) prod[k] = spec[k] * std::conj(tspec[k]);
+    fftw_execute(p.inv);
+    for (std::size_t lag = 0; lag + nt <= x.size(); lag += std::max<std::size_t>(1, x.size() / 50)) {
+      double direct = 0;
+      for (std::size_t i = 0; i < nt; ++i) direct += x[lag + i] * t[i];
+      EXPECT_NEAR(out[lag] / static_cast<double>(nfft), direct, 1e-10) << nfft << " lag " << lag;
+    }
+    const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+    fftw_destroy_plan(p.fwd);
+    fftw_destroy_plan(p.inv);
+  }
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    EXPECT_EQ(convolve(ops[i].first, ops[i].second), before[i]) << i;
+  }
+  EXPECT_THROW(plan_correlation(0, nullptr, nullptr, nullptr, nullptr), InputError);
 }

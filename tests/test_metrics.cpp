@@ -11,6 +11,7 @@
 #include "tests/process.hpp"
 
 #include "model/base/error.hpp"
+#include "model/base/aligned.hpp"
 #include "model/sim/fft.hpp"
 #include "model/sim/metrics.hpp"
 
@@ -326,7 +327,8 @@ TEST(PearsonOverLags, TheVectorLoopsGiveTheScalarAlgorithmsBits) {
     for (double v : lane) mean += v;
     mean /= static_cast<double>(w);
     // prefix sums in eight chunks of ceil(w / 8) samples, then each chunk plus the ones before
-    std::vector<double> s1(w + 1, 0.0), s2(w + 1, 0.0), den(lags), in(nfft, 0.0), out(nfft);
+    std::vector<double> s1(w + 1, 0.0), s2(w + 1, 0.0), den(lags);
+    AlignedVector<double> in(nfft, 0.0), out(nfft);  // aligned as the bank's (the plans' alignment)
     const std::size_t len = (w + 7) / 8;
     double o1 = 0, o2 = 0;
     for (std::size_t c = 0; c * len < w; ++c) {
@@ -349,13 +351,13 @@ TEST(PearsonOverLags, TheVectorLoopsGiveTheScalarAlgorithmsBits) {
       den_max = std::max(den_max, den[k]);
     }
     for (double& d : den) d = d > 1e-24 * den_max && d > 0 ? std::sqrt(d) : 0.0;
-    std::vector<std::complex<double>> xs(nc), prod(nc), tsp(nc);
-    fftw_plan fwd = fftw_plan_dft_r2c_1d(static_cast<int>(nfft), in.data(), reinterpret_cast<fftw_complex*>(xs.data()),
-                                         FFTW_ESTIMATE);
-    fftw_plan inv = fftw_plan_dft_c2r_1d(static_cast<int>(nfft), reinterpret_cast<fftw_complex*>(prod.data()),
-                                         out.data(), FFTW_ESTIMATE);
+    AlignedVector<std::complex<double>> xs(nc), prod(nc), tsp(nc);
+    // the bank's plans (plan_correlation: the wisdom's where it applies)
+    const CorrelationPlans plans = plan_correlation(nfft, in.data(), reinterpret_cast<fftw_complex*>(xs.data()),
+                                                    reinterpret_cast<fftw_complex*>(prod.data()), out.data());
+    const fftw_plan fwd = plans.fwd, inv = plans.inv;
     fftw_execute(fwd);
-    const std::vector<std::complex<double>> xspec = xs;
+    const AlignedVector<std::complex<double>> xspec = xs;
     for (std::size_t j = 0; j < ts.size(); ++j) {
       double m = 0, ss = 0;
       for (double v : ts[j]) m += v;

@@ -17,6 +17,51 @@ std::mutex& fftw_planner_mutex() {
 }
 
 namespace {
+// FFTW_MEASURE wisdom of the correlation sizes (generated: bench/fft_wisdom_gen.cpp).
+constexpr const char* kCorrelationWisdom =
+#include "model/sim/fft_wisdom.inc"
+    ;
+}  // namespace
+
+bool correlation_wisdom_applies() {
+  const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+  fftw_forget_wisdom();
+  const bool ok = fftw_import_wisdom_from_string(kCorrelationWisdom) != 0;
+  fftw_forget_wisdom();
+  return ok;
+}
+
+CorrelationPlans plan_correlation(std::size_t nfft, double* in, fftw_complex* spec, fftw_complex* prod, double* out) {
+  if (nfft < 1 || nfft > (std::size_t{1} << 30)) {
+    throw InputError("plan_correlation: " + std::to_string(nfft) + " points; valid 1..2^30");
+  }
+  const int n = static_cast<int>(nfft);
+  CorrelationPlans p;
+  const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
+  // Only the wisdom's entries, then nothing: FFTW keeps wisdom process-wide, and what other plans
+  // left there must not decide these two, nor these entries any later plan.
+  fftw_forget_wisdom();
+  if (fftw_import_wisdom_from_string(kCorrelationWisdom) != 0) {
+    p.fwd = fftw_plan_dft_r2c_1d(n, in, spec, FFTW_MEASURE | FFTW_WISDOM_ONLY);
+    p.inv = fftw_plan_dft_c2r_1d(n, prod, out, FFTW_MEASURE | FFTW_WISDOM_ONLY);
+  }
+  fftw_forget_wisdom();
+  p.measured = p.fwd != nullptr && p.inv != nullptr;
+  if (!p.measured) {
+    if (p.fwd) fftw_destroy_plan(p.fwd);
+    if (p.inv) fftw_destroy_plan(p.inv);
+    p.fwd = fftw_plan_dft_r2c_1d(n, in, spec, FFTW_ESTIMATE);
+    p.inv = fftw_plan_dft_c2r_1d(n, prod, out, FFTW_ESTIMATE);
+  }
+  if (!p.fwd || !p.inv) {
+    if (p.fwd) fftw_destroy_plan(p.fwd);
+    if (p.inv) fftw_destroy_plan(p.inv);
+    throw std::bad_alloc();
+  }
+  return p;
+}
+
+namespace {
 
 std::vector<double> convolve_direct(std::span<const double> a, std::span<const double> b) {
   std::vector<double> c(a.size() + b.size() - 1, 0.0);

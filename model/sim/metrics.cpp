@@ -101,13 +101,10 @@ PearsonBank::Plan& PearsonBank::plan(std::size_t nfft) {
   p->prod.assign(nc, 0.0);
   auto* spec = reinterpret_cast<fftw_complex*>(p->spec.data());
   auto* prod = reinterpret_cast<fftw_complex*>(p->prod.data());
-  const int n = static_cast<int>(nfft);
-  {
-    const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-    p->fwd = fftw_plan_dft_r2c_1d(n, p->in.data(), spec, FFTW_ESTIMATE);
-    p->inv = fftw_plan_dft_c2r_1d(n, prod, p->out.data(), FFTW_ESTIMATE);
-  }
-  if (!p->fwd || !p->inv) throw std::bad_alloc();
+  const CorrelationPlans made = plan_correlation(nfft, p->in.data(), spec, prod, p->out.data());
+  p->fwd = made.fwd;
+  p->inv = made.inv;
+  measured_ = made.measured;
   for (const auto& t : t_) {
     std::fill(p->in.begin(), p->in.end(), 0.0);
     std::copy(t.begin(), t.end(), p->in.begin());

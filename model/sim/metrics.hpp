@@ -42,8 +42,9 @@ LagRho pearson_over_lags(std::span<const double> x, std::span<const double> t, l
 // Not thread-safe per object (it owns FFTW buffers); plans are made once per transform size.
 // max_lags > 0: every search of at most max_lags lags uses the transform size of max_lags lags
 // (a window cut short at the signal's edge is zero-padded to it), so a stream's bursts need one
-// FFTW plan, not one more per edge window (FFTW_ESTIMATE planning costs 2-6 ms per new size);
-// rho is the same to a few ulps as on the window's own size.
+// FFTW plan, not one more per edge window (planning an estimate costs 2-6 ms per new size);
+// rho is the same to a few ulps as on the window's own size. The plans: plan_correlation
+// (model/sim/fft.hpp), measured ones from the project's wisdom where it applies.
 class PearsonBank {
  public:
   // InputError if templates is empty, their lengths differ, or are < 2.
@@ -58,6 +59,9 @@ class PearsonBank {
   // The lags are screened by a multiply before rho is divided out (the same result bit for bit);
   // off: every lag's rho is computed (the reference the tests compare the screening with).
   void set_screening(bool on) { screen_ = on; }
+  // Whether the last plan made came from the project's FFTW wisdom (plan_correlation); false
+  // before the first search.
+  bool measured_plans() const { return measured_; }
 
  private:
   struct Plan;
@@ -65,6 +69,7 @@ class PearsonBank {
   std::size_t n_ = 0;
   std::size_t max_lags_ = 0;
   bool screen_ = true;
+  bool measured_ = false;
   std::vector<std::vector<double>> t_;  // centred templates
   std::vector<double> tnorm_;           // sqrt(sum tc^2)
   std::map<std::size_t, std::unique_ptr<Plan>> plans_;
