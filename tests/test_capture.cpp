@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -297,6 +298,21 @@ TEST(DecodeCli, BadCapturesExitTwoWithAClearMessageAndNoOutput) {
     EXPECT_EQ(r.status, 2);
     EXPECT_TRUE(r.out.empty());
     EXPECT_NE(r.err.find(k.expect), std::string::npos);
+  }
+  // The capture's pass runs beside the receiver's setup (decode): when both fail, the capture's
+  // error is the one reported (as when the pass came first), at any --jobs.
+  {
+    Capture f = c;
+    f.samples[4321] = std::numeric_limits<double>::infinity();
+    write(dir + "/inf32.wav", capture_wav(f, WavFormat::Float32));
+    for (const char* jobs : {"1", "2"}) {
+      const ToolRun r = run_tool("decode " + dir + "/inf32.wav --family M9 --jobs " + jobs);
+      EXPECT_EQ(r.status, 2) << jobs;
+      EXPECT_TRUE(r.out.empty()) << jobs;
+      EXPECT_NE(r.err.find("inf32.wav: byte "), std::string::npos) << r.err;
+      EXPECT_NE(r.err.find("sample 4321 is not finite"), std::string::npos) << r.err;
+      EXPECT_EQ(r.err.find("unknown code family"), std::string::npos) << r.err;
+    }
   }
   // A sample rate the receiver cannot use (4.9 MS/s: 24.5 samples per carrier cycle).
   std::string odd = "TIME,CH1\n";

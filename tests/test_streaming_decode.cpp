@@ -16,7 +16,10 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <limits>
+#include <optional>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -353,6 +356,71 @@ TEST(StreamingDecode, TheOpenScanInPartsReportsTheFirstInvalidSample) {
         streamed = e.what();
       }
       EXPECT_EQ(streamed, whole) << name << " parts " << parts;
+    }
+  }
+}
+
+// The open in two steps (decode prepares its receiver meanwhile): the header's accessors at
+// once, then finish() runs the pass the one-step constructor runs, with the same blocks, the
+// same first invalid sample and the same samples read after; reading before finish(), or
+// finishing twice, is a programming error.
+TEST(StreamingDecode, TheDeferredPassIsTheOpenPassRunLater) {
+  Capture c;
+  c.sample_rate = 1e6;
+  std::mt19937_64 rng(6);
+  c.samples.resize(2 * 65536 + 999);
+  for (double& v : c.samples) v = std::uniform_real_distribution<double>(-0.9, 0.9)(rng);
+  Capture small = c;
+  small.samples.resize(20000);
+  Capture bad = c;
+  bad.samples[70001] = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"deferred32f.wav", capture_wav(c, WavFormat::Float32)},
+      {"deferred16.wav", capture_wav(c, WavFormat::Pcm16, 1.0)},
+      {"deferred.csv", capture_csv(small)},
+      {"deferred_nan.wav", capture_wav(bad, WavFormat::Float64)}};
+  for (const auto& [name, bytes] : files) {
+    const std::string p = write(name, bytes);
+    for (std::size_t parts : {1, 2, 3}) {
+      SCOPED_TRACE(name + " parts " + std::to_string(parts));
+      using Seen = std::vector<std::vector<std::vector<double>>>;
+      Seen now(parts), later(parts);
+      std::string now_error, later_error;
+      std::optional<CaptureSource> one;
+      try {
+        one.emplace(p, CaptureRead{}, [&](std::size_t k, std::span<const double> x) { now[k].emplace_back(x.begin(), x.end()); },
+                    parts);
+      } catch (const InputError& e) {
+        now_error = e.what();
+      }
+      CaptureSource two(p, {}, [&](std::size_t k, std::span<const double> x) { later[k].emplace_back(x.begin(), x.end()); },
+                        parts, CaptureSource::Deferred{});
+      const bool csv = name.ends_with(".csv");
+      if (!csv) {  // nothing of the samples yet
+        for (const auto& part : later) EXPECT_TRUE(part.empty());
+      }
+      std::vector<double> x(100);
+      EXPECT_THROW((void)two.read(x), std::logic_error);
+      EXPECT_THROW(two.rewind(), std::logic_error);
+      EXPECT_EQ(two.size(), csv ? small.samples.size() : c.samples.size());
+      EXPECT_EQ(two.sample_rate(), 1e6);
+      try {
+        two.finish();
+      } catch (const InputError& e) {
+        later_error = e.what();
+      }
+      EXPECT_EQ(later_error, now_error);
+      EXPECT_EQ(later, now);
+      if (!now_error.empty()) {
+        EXPECT_NE(now_error.find("sample 70001 is not finite"), std::string::npos) << now_error;
+        continue;
+      }
+      std::vector<double> a(two.size()), b(two.size());
+      EXPECT_EQ(two.read(a), a.size());
+      EXPECT_EQ(one->read(b), b.size());
+      EXPECT_EQ(a, b);
+      EXPECT_EQ(a, read_capture(p).samples);
+      EXPECT_THROW(two.finish(), std::logic_error);
     }
   }
 }

@@ -9,7 +9,10 @@
 #include <limits>
 #include <cstdio>
 #include <iostream>
+#include <exception>
+#include <functional>
 #include <optional>
+#include <thread>
 #include <sstream>
 
 #include "model/sim/capture.hpp"
@@ -144,6 +147,10 @@ void plot_decode(const std::string& png, const Scene& scene, const std::string& 
   plot_with_script("option --plot", "scripts/plot_decode.py", j, png);
 }
 
+int decode_opened(cli::Parser& p, const std::string& path, const CaptureRead& how, int channel,
+                  std::optional<std::size_t> block_option, int jobs, CaptureSource& cap, FlatTopScan& scan,
+                  const std::function<void()>& wait_for_pass);
+
 }  // namespace
 
 int cmd_decode(const Args& args) {
@@ -179,11 +186,45 @@ int cmd_decode(const Args& args) {
   // The open pass runs on the --jobs threads (a WAV's parts, each with its own levels).
   const int jobs = jobs_option(p);
   std::vector<FlatTopScan> part_levels(static_cast<std::size_t>(jobs));
+  // The header now; the pass over the samples (a WAV's validation and the extremes) on a thread
+  // of its own while this one sets the receiver up (scene, design, latency calibration, FFT
+  // plans): neither needs the other until the decode starts. When the capture's pass fails, its
+  // error is the one reported, as when the pass came first.
   CaptureSource cap(
       path, how, [&](std::size_t part, std::span<const double> x) { part_levels[part].levels(x); },
-      part_levels.size());
+      part_levels.size(), CaptureSource::Deferred{});
+  std::exception_ptr pass_error;
+  std::thread pass([&] {
+    try {
+      cap.finish();
+    } catch (...) {
+      pass_error = std::current_exception();
+    }
+  });
   FlatTopScan scan;
-  for (const auto& s : part_levels) scan.merge_levels(s);
+  const std::function<void()> wait_for_pass = [&] {
+    pass.join();
+    if (pass_error) std::rethrow_exception(pass_error);
+    for (const auto& s : part_levels) scan.merge_levels(s);
+  };
+  try {
+    return decode_opened(p, path, how, channel, block_option, jobs, cap, scan, wait_for_pass);
+  } catch (...) {
+    if (pass.joinable()) {
+      pass.join();
+      if (pass_error) std::rethrow_exception(pass_error);
+    }
+    throw;
+  }
+}
+
+namespace {
+
+// cmd_decode once the capture's header is read: wait_for_pass() returns when its pass over the
+// samples has (scan then holds the capture's extremes), or rethrows that pass's error.
+int decode_opened(cli::Parser& p, const std::string& path, const CaptureRead& how, int channel,
+                  std::optional<std::size_t> block_option, int jobs, CaptureSource& cap, FlatTopScan& scan,
+                  const std::function<void()>& wait_for_pass) {
   std::string rate_note;  // where the sample rate came from, when an option set it
   if (how.sample_rate > 0) {
     std::ostringstream os;
@@ -299,6 +340,7 @@ int cmd_decode(const Args& args) {
   while (!block_option && block < (std::size_t{1} << 20) && 2 * block <= cap.size() / 64) block *= 2;
   SceneSimulator sim(scene);
   sim.set_jobs(jobs);
+  sim.prepare(family);  // the receiver's design, calibration and plans, beside the capture's pass
 
   std::optional<LatencyCalibration> cal;
   if (p.has("--calibrate")) {
@@ -318,6 +360,7 @@ int cmd_decode(const Args& args) {
     cal = calibrate_latency(kd, cal_distance, c.value, "option --calibrate (" + cal_path + ")");
   }
 
+  wait_for_pass();
   const FlatTops levels = scan.result();
   const double peak = std::max(std::abs(levels.high), std::abs(levels.low));
   std::vector<Detection> dets, below;
@@ -435,5 +478,7 @@ int cmd_decode(const Args& args) {
   }
   return dets.empty() ? 1 : 0;
 }
+
+}  // namespace
 
 }  // namespace ranging::tool

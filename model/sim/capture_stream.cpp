@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <stdexcept>
 #include <vector>
 
 #include "model/base/error.hpp"
@@ -24,6 +25,12 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how,
 
 CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& part_scan,
                              std::size_t parts)
+    : CaptureSource(path, how, part_scan, parts, Deferred{}) {
+  finish();
+}
+
+CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& part_scan,
+                             std::size_t parts, Deferred)
     : path_(path) {
   const auto scan = [&](std::span<const double> x) { part_scan(0, x); };  // a CSV: one part
   std::vector<double> block;  // scan's samples
@@ -89,42 +96,65 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, co
     file_rate_ = wav_.rate;
     rate_ = how.sample_rate > 0 ? how.sample_rate : wav_.rate;
     n_ = wav_.n;
-    if (wav_.flt || n_ < 2 || part_scan) {  // NaN/Inf are refused before anything is decoded (read_capture's order)
-      // Blocks of 2^16 frames; part p reads blocks [p B / P, (p + 1) B / P) through a stream of
-      // its own. Each part stops at its first invalid sample; parallel_items rethrows the first
-      // part's error, so the file's first invalid sample is the one reported.
-      constexpr std::size_t kScan = std::size_t{1} << 16;
-      const std::size_t blocks = (n_ + kScan - 1) / kScan;
-      const std::size_t np = std::clamp<std::size_t>(parts, 1, std::max<std::size_t>(blocks, 1));
-      parallel_items(np, np, [&](std::size_t part, std::size_t) {
-        const std::size_t b0 = part * blocks / np, b1 = (part + 1) * blocks / np;
-        if (b0 == b1) return;
-        std::ifstream own;
-        if (part > 0) {
-          own.open(path, std::ios::binary);
-          if (!own) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
-        }
-        std::ifstream& in = part > 0 ? own : in_;
-        in.clear();
-        in.seekg(static_cast<std::streamoff>(wav_.body + b0 * kScan * wav_.frame));
-        std::string bytes;
-        std::vector<double> out(kScan);
-        for (std::size_t b = b0; b < b1; ++b) {
-          const std::size_t m = std::min(kScan, n_ - b * kScan);
-          wav_frames(in, bytes, b * kScan, m, out.data());
-          if (part_scan) part_scan(part, std::span<const double>(out.data(), m));
-        }
-      });
+    if (n_ < 2) {  // its one sample's NaN/Inf first (read_capture's order)
+      wav_pass(part_scan, 1);
+      throw InputError(path + ": byte " + std::to_string(wav_.chunk_at) + ": the data chunk holds fewer than two samples");
     }
-    if (n_ < 2) throw InputError(path + ": byte " + std::to_string(wav_.chunk_at) + ": the data chunk holds fewer than two samples");
+    if (wav_.flt || part_scan) {  // finish(): NaN/Inf are refused before anything is decoded
+      pending_scan_ = part_scan;
+      pending_parts_ = parts;
+      pending_ = true;
+    }
   }
   merge_capture_sidecar(meta_, path);
-  rewind();
+  if (!pending_) seek_start();
+}
+
+void CaptureSource::finish() {
+  if (finished_) throw std::logic_error("CaptureSource::finish: called twice");
+  finished_ = true;
+  if (!pending_) return;  // a CSV, or an integer WAV without a scan: nothing was deferred
+  wav_pass(pending_scan_, pending_parts_);
+  pending_ = false;
+  seek_start();
+}
+
+void CaptureSource::wav_pass(const PartScan& part_scan, std::size_t parts) {
+  // Blocks of 2^16 frames; part p reads blocks [p B / P, (p + 1) B / P) through a stream of
+  // its own. Each part stops at its first invalid sample; parallel_items rethrows the first
+  // part's error, so the file's first invalid sample is the one reported.
+  constexpr std::size_t kScan = std::size_t{1} << 16;
+  const std::size_t blocks = (n_ + kScan - 1) / kScan;
+  const std::size_t np = std::clamp<std::size_t>(parts, 1, std::max<std::size_t>(blocks, 1));
+  parallel_items(np, np, [&](std::size_t part, std::size_t) {
+    const std::size_t b0 = part * blocks / np, b1 = (part + 1) * blocks / np;
+    if (b0 == b1) return;
+    std::ifstream own;
+    if (part > 0) {
+      own.open(path_, std::ios::binary);
+      if (!own) throw InputError(path_ + ": cannot open the capture file: " + std::strerror(errno));
+    }
+    std::ifstream& in = part > 0 ? own : in_;
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(wav_.body + b0 * kScan * wav_.frame));
+    std::string bytes;
+    std::vector<double> out(kScan);
+    for (std::size_t b = b0; b < b1; ++b) {
+      const std::size_t m = std::min(kScan, n_ - b * kScan);
+      wav_frames(in, bytes, b * kScan, m, out.data());
+      if (part_scan) part_scan(part, std::span<const double>(out.data(), m));
+    }
+  });
 }
 
 CaptureSource::~CaptureSource() = default;
 
 void CaptureSource::rewind() {
+  if (!finished_) throw std::logic_error("CaptureSource: rewind() before finish()");
+  seek_start();
+}
+
+void CaptureSource::seek_start() {
   in_.clear();
   pos_ = 0;
   lineno_ = 0;
@@ -136,6 +166,7 @@ void CaptureSource::rewind() {
 }
 
 std::size_t CaptureSource::read(std::span<double> out) {
+  if (!finished_) throw std::logic_error("CaptureSource: read() before finish()");
   std::size_t k = 0;
   if (csv_) {
     std::string line;

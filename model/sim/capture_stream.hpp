@@ -99,6 +99,17 @@ class CaptureSource {
   // sample is reported as the one-part pass reports it: the first in the file.
   using PartScan = std::function<void(std::size_t part, std::span<const double>)>;
   CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& scan, std::size_t parts);
+  // The same in two steps, so a caller can prepare beside the pass over the samples (decode
+  // sets up its receiver meanwhile): this constructor reads a WAV's header and metadata (and its
+  // sidecar) only; finish() then runs the WAV's validation pass and the scan, on the calling
+  // thread and up to `parts` workers, exactly as the constructor above would have. A CSV's rate
+  // and metadata come from its rows, so its whole pass runs here and finish() has nothing left.
+  // Until finish() has returned, only the header's accessors below are valid (read() and
+  // rewind() throw std::logic_error); they do not change during finish(), so another thread
+  // may read them meanwhile. finish() runs once (std::logic_error after).
+  struct Deferred {};
+  CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& scan, std::size_t parts, Deferred);
+  void finish();
   ~CaptureSource();
   int channels() const { return channels_; }  // how many the file has
   double file_rate() const { return file_rate_; }  // the rate the file states (0: none)
@@ -122,6 +133,13 @@ class CaptureSource {
   std::size_t first_data_line_ = 0, lineno_ = 0;
   std::ifstream in_;
   std::string buf_;
+  PartScan pending_scan_;            // Deferred: finish()'s scan
+  std::size_t pending_parts_ = 1;
+  bool pending_ = false;             // Deferred: the WAV's pass has not run
+  bool finished_ = false;            // finish() has run
+  void seek_start();  // the next read() gives sample 0
+  // The WAV's pass over every sample (validation of a float WAV, the scan) in parts.
+  void wav_pass(const PartScan& scan, std::size_t parts);
   // frames [i0, i0 + m) of the data chunk from `in` (positioned there) into out, through buf
   void wav_frames(std::ifstream& in, std::string& buf, std::size_t i0, std::size_t m, double* out) const;
 };

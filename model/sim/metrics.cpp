@@ -90,6 +90,12 @@ PearsonBank::PearsonBank(std::vector<std::vector<double>> templates, std::size_t
 
 PearsonBank::~PearsonBank() = default;
 
+std::size_t PearsonBank::transform_size(std::size_t window) { return std::max<std::size_t>(64, correlation_fft_size(window)); }
+
+void PearsonBank::prepare() {
+  if (max_lags_ > 0) (void)plan(transform_size(max_lags_ + n_ - 1));
+}
+
 PearsonBank::Plan& PearsonBank::plan(std::size_t nfft) {
   if (auto it = plans_.find(nfft); it != plans_.end()) return *it->second;
   auto p = std::make_unique<Plan>();
@@ -333,7 +339,7 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   // any size >= w holds the lags' circular correlation without wrap: the next fast size (of the
   // bank's max_lags window when this one is shorter: one plan for every window of a stream)
   const std::size_t w_size = lags <= max_lags_ ? max_lags_ + n_ - 1 : w;
-  const std::size_t nfft = std::max<std::size_t>(64, correlation_fft_size(w_size));
+  const std::size_t nfft = transform_size(w_size);
   Plan& p = plan(nfft);
   const double* xw = x.data() + a;
   // Segment sums of (x - mean) and its square by prefix sums; x - mean is the transform's input.

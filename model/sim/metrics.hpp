@@ -59,6 +59,8 @@ class PearsonBank {
   // The lags are screened by a multiply before rho is divided out (the same result bit for bit);
   // off: every lag's rho is computed (the reference the tests compare the screening with).
   void set_screening(bool on) { screen_ = on; }
+  // Makes the transform plans of a max_lags search now (else the first search makes them).
+  void prepare();
   // Whether the last plan made came from the project's FFTW wisdom (plan_correlation); false
   // before the first search.
   bool measured_plans() const { return measured_; }
@@ -66,6 +68,7 @@ class PearsonBank {
  private:
   struct Plan;
   Plan& plan(std::size_t nfft);
+  static std::size_t transform_size(std::size_t window);  // of a window of `window` samples
   std::size_t n_ = 0;
   std::size_t max_lags_ = 0;
   bool screen_ = true;

@@ -724,6 +724,11 @@ SceneSimulator::SceneSimulator(Scene scene) : scene_(std::move(scene)), stages_(
 }
 SceneSimulator::~SceneSimulator() = default;
 
+void SceneSimulator::prepare(const std::string& family) {
+  Link& lk = link(family);
+  if (lk.bank) lk.bank->prepare();
+}
+
 SceneSimulator::Link& SceneSimulator::link(const std::string& family) {
   for (auto& l : links_) {
     if (l->family_name == family) return *l;

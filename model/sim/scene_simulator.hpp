@@ -179,6 +179,12 @@ class SceneSimulator {
   // Number of receiver runs (streams) of run(family), for progress bars.
   std::size_t streams(const std::string& family) const;
 
+  // Builds now what decoding or simulating `family` needs: the receiver's design, its latency
+  // calibration, the Pearson references and their transform plans (else made on first use), so
+  // a caller can have it done beside other work (decode: beside the capture's open pass). The
+  // results do not change. InputError as run().
+  void prepare(const std::string& family);
+
   // Decode a recorded stream (volts or any scale; fs must be the scene's): every event the
   // receiver emits, with t0 the time of sample 0. period_s > 0: the bursts were sent every
   // period_s, codes 1..eta in order, so tof = arrival - (latest send of that code).
