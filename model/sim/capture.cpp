@@ -12,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 
 #include <nlohmann/json.hpp>
@@ -23,9 +24,9 @@
 
 namespace ranging {
 
-char csv_separator(const std::string& line) {
-  if (line.find(';') != std::string::npos) return ';';
-  if (line.find(',') != std::string::npos) return ',';
+char csv_separator(std::string_view line) {
+  if (line.find(';') != std::string_view::npos) return ';';
+  if (line.find(',') != std::string_view::npos) return ',';
   return '\0';
 }
 
@@ -74,30 +75,41 @@ namespace {
   throw InputError(origin + ":" + std::to_string(line) + ": " + what);
 }
 
-std::string trim(const std::string& s) {
+std::string_view trim(std::string_view s) {
   const auto b = s.find_first_not_of(" \t\r\"");
-  if (b == std::string::npos) return "";
+  if (b == std::string_view::npos) return {};
   const auto e = s.find_last_not_of(" \t\r\"");
   return s.substr(b, e - b + 1);
 }
 
 // Strict number: the whole cell must parse (strtod also accepts nan/inf: refused by caller).
-bool parse_number(const std::string& cell, double& out) {
+// read_decimal's fast path reads the cell in place; its strtod fallback gets a NUL-terminated
+// copy of the cell (a cell is not one in its line).
+bool parse_number(std::string_view cell, double& out) {
   if (cell.empty()) return false;
-  const char* b = cell.c_str();
-  const Decimal d = read_decimal(b, b + cell.size());
+  const char* b = cell.data();
+  const char* e = b + cell.size();
+  double v = 0;
+  const auto r = std::from_chars(b, e, v);
+  if (r.ec == std::errc() && std::isnormal(v)) {
+    out = v;
+    return r.ptr == e;
+  }
+  const std::string copy(cell);
+  const Decimal d = read_decimal(copy.c_str(), copy.c_str() + copy.size());
   out = d.value;
-  return d.end == b + cell.size() && !d.range_error;
+  return d.end == copy.c_str() + copy.size() && !d.range_error;
 }
 
-// The cells of one line. Separator (csv_separator): ';' if the line has one (a European export;
-// decimal commas are not read: such a cell is refused as not a number), else ',' if it has one,
-// else runs of tabs and spaces (numpy.savetxt's default, SPICE and tab-separated exports).
-// (By hand, not through a std::stringstream per line: its construction and locale look-ups were
-// a fifth of a CSV decode.) Whitespace runs split as operator>> does (C-locale isspace); a
-// separator splits into every field, so "a,b," is "a", "b", "".
-std::vector<std::string> split_cells(const std::string& line) {
-  std::vector<std::string> cells;
+// The cells of one line, views into it. Separator (csv_separator): ';' if the line has one (a
+// European export; decimal commas are not read: such a cell is refused as not a number), else
+// ',' if it has one, else runs of tabs and spaces (numpy.savetxt's default, SPICE and
+// tab-separated exports). (By hand, not through a std::stringstream per line: its construction
+// and locale look-ups were a fifth of a CSV decode; views, not strings: a row's allocations were
+// a sixth.) Whitespace runs split as operator>> does (C-locale isspace); a separator splits into
+// every field, so "a,b," is "a", "b", "".
+void split_cells(std::string_view line, std::vector<std::string_view>& cells) {
+  cells.clear();
   const char sep = csv_separator(line);
   if (sep == '\0') {
     std::size_t i = 0;
@@ -108,16 +120,15 @@ std::vector<std::string> split_cells(const std::string& line) {
       while (i < line.size() && !space(i)) ++i;
       if (i > b) cells.push_back(line.substr(b, i - b));
     }
-    return cells;
+    return;
   }
-  if (line.empty()) return cells;
+  if (line.empty()) return;
   for (std::size_t b = 0;;) {
     const std::size_t e = line.find(sep, b);
-    cells.push_back(trim(line.substr(b, e == std::string::npos ? std::string::npos : e - b)));
-    if (e == std::string::npos) break;
+    cells.push_back(trim(line.substr(b, e == std::string_view::npos ? std::string_view::npos : e - b)));
+    if (e == std::string_view::npos) break;
     b = e + 1;
   }
-  return cells;
 }
 
 }  // namespace
@@ -230,7 +241,8 @@ bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
     if (data_) fail_at(origin_, lineno_, "empty line inside the data rows");
     return false;
   }
-  const auto cells = split_cells(text);
+  split_cells(text, cells_);
+  const std::vector<std::string_view>& cells = cells_;
   double first = 0;
   const bool numeric_first = !cells.empty() && parse_number(cells[0], first);
   if (!data_ && !numeric_first) {  // header line (before the first data row); metadata keys
@@ -238,7 +250,7 @@ bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
       record_length_ = first;
       record_line_ = lineno_;
     }
-    if (cells.size() >= 2) read_meta_line(meta_, cells[0], cells[1], origin_, lineno_);
+    if (cells.size() >= 2) read_meta_line(meta_, std::string(cells[0]), std::string(cells[1]), origin_, lineno_);
     return false;
   }
   if (!data_) {
@@ -263,8 +275,10 @@ bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
     if (channel_ != 1) {
       fail_at(origin_, lineno_, "channel " + std::to_string(channel_) + " is out of range: the rows have 1 channel; valid 1..1");
     }
-    if (!parse_number(cells[0], x)) fail_at(origin_, lineno_, "sample: '" + cells[0] + "' is not a number");
-    if (!std::isfinite(x)) fail_at(origin_, lineno_, "sample: '" + cells[0] + "' is not finite (NaN or Inf)");
+    if (!parse_number(cells[0], x)) fail_at(origin_, lineno_, "sample: '" + std::string(cells[0]) + "' is not a number");
+    if (!std::isfinite(x)) {
+      fail_at(origin_, lineno_, "sample: '" + std::string(cells[0]) + "' is not finite (NaN or Inf)");
+    }
     t = static_cast<double>(rows_) / given_rate_;
     if (rows_ == 0) t_first_ = t;
     t_last_ = t;
@@ -283,18 +297,19 @@ bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
                                   ") is out of range: the row has " + std::to_string(cells.size() - 1) +
                                   " channel(s); valid 1.." + std::to_string(cells.size() - 1));
   }
-  double val[2];
+  double val[2] = {0, 0};
   for (int c = 0; c < 2; ++c) {
-    const std::string& cell = cells[c == 0 ? 0 : ch];
-    const std::string what = c == 0 ? std::string("time") : channel_ == 1 ? std::string("voltage")
-                                                                          : "channel " + std::to_string(channel_);
-    if (!parse_number(cell, val[c])) fail_at(origin_, lineno_, what + " column: '" + cell + "' is not a number");
-    if (!std::isfinite(val[c])) {
-      fail_at(origin_, lineno_, what + " column: '" + cell + "' is not finite (NaN or Inf)");
-    }
+    const std::string_view cell = cells[c == 0 ? 0 : ch];
+    const auto bad = [&](const char* why) {
+      const std::string what = c == 0 ? std::string("time") : channel_ == 1 ? std::string("voltage")
+                                                                            : "channel " + std::to_string(channel_);
+      fail_at(origin_, lineno_, what + " column: '" + std::string(cell) + "' " + why);
+    };
+    if (!parse_number(cell, val[c])) bad("is not a number");
+    if (!std::isfinite(val[c])) bad("is not finite (NaN or Inf)");
   }
   if (rows_ > 0 && !(val[0] > t_last_)) {
-    fail_at(origin_, lineno_, "time does not increase (" + cells[0] + " after the previous row)");
+    fail_at(origin_, lineno_, "time does not increase (" + std::string(cells[0]) + " after the previous row)");
   }
   if (rows_ == 0) t_first_ = val[0];
   t_last_ = val[0];

@@ -65,13 +65,17 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, co
     if (in_.bad()) throw InputError(path + ": cannot read the capture file");
     rows.finish();
     if (part_scan && !block.empty()) scan(block);
-    // Second pass: every row on the uniform grid (the rows are known to be well formed now).
+    // Second pass: every row on the uniform grid. The rows are known to be well formed now, and
+    // every line from the first data row on is one (an empty line among them was refused), so
+    // only the time cell is read, as read() reads a cell.
     in_.clear();
     in_.seekg(0);
-    CsvCaptureScan again(path, how);
-    std::size_t n = 0;
-    while (std::getline(in_, line)) {
-      if (again.line(line, t, v)) rows.check_grid(n++, t, again.lineno());
+    if (rows.has_time()) {
+      std::size_t n = 0, lineno = 0;
+      while (std::getline(in_, line)) {
+        if (++lineno < rows.first_data_line()) continue;
+        rows.check_grid(n++, csv_row_value(line, 0), lineno);
+      }
     }
     rate_ = rows.sample_rate();
     t0_ = rows.t0();

@@ -20,6 +20,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "model/sim/capture.hpp"
 
@@ -28,7 +29,7 @@ namespace ranging {
 // A CSV line's separator: ';' if it has one, else ',' if it has one, else '\0' (runs of tabs
 // and spaces). csv_row_value: cell `cell` (0-based: 1 is the first channel after the time) of a
 // data row that CsvCaptureScan validated.
-char csv_separator(const std::string& line);
+char csv_separator(std::string_view line);
 double csv_row_value(const std::string& line, int cell = 1);
 
 class CsvCaptureScan {
@@ -59,6 +60,7 @@ class CsvCaptureScan {
   std::size_t lineno_ = 0, rows_ = 0, first_data_line_ = 0, last_data_line_ = 0, record_line_ = 0;
   bool data_ = false;
   double record_length_ = -1, t_first_ = 0, t_last_ = 0, dt_ = 0;
+  std::vector<std::string_view> cells_;  // line()'s cells of the current line (views into it)
 };
 
 struct WavLayout {
