@@ -275,15 +275,23 @@ TEST(StreamingDecode, TheOpenScanSeesTheSamplesReadGives) {
   }
 }
 
+namespace {
+// n samples at 1 MS/s, uniform in [-0.9, 0.9) from seed.
+Capture uniform_capture(std::size_t n, std::uint64_t seed) {
+  Capture c;
+  c.sample_rate = 1e6;
+  std::mt19937_64 rng(seed);
+  c.samples.resize(n);
+  for (double& v : c.samples) v = std::uniform_real_distribution<double>(-0.9, 0.9)(rng);
+  return c;
+}
+}  // namespace
+
 // The scan in parts (decode --jobs): a WAV's samples in consecutive runs of whole 65536-sample
 // blocks, part p's before part p + 1's, each part's blocks in order and those of the one-part
 // scan; a CSV is one part; more parts than blocks leave the rest unused.
 TEST(StreamingDecode, TheOpenScanInPartsSeesEveryBlockOnce) {
-  Capture c;
-  c.sample_rate = 1e6;
-  std::mt19937_64 rng(5);
-  c.samples.resize(3 * 65536 + 1234);
-  for (double& v : c.samples) v = std::uniform_real_distribution<double>(-0.9, 0.9)(rng);
+  const Capture c = uniform_capture(3 * 65536 + 1234, 5);
   Capture small = c;
   small.samples.resize(70000);
   const std::vector<std::pair<std::string, std::string>> files = {
@@ -365,11 +373,7 @@ TEST(StreamingDecode, TheOpenScanInPartsReportsTheFirstInvalidSample) {
 // same first invalid sample and the same samples read after; reading before finish(), or
 // finishing twice, is a programming error.
 TEST(StreamingDecode, TheDeferredPassIsTheOpenPassRunLater) {
-  Capture c;
-  c.sample_rate = 1e6;
-  std::mt19937_64 rng(6);
-  c.samples.resize(2 * 65536 + 999);
-  for (double& v : c.samples) v = std::uniform_real_distribution<double>(-0.9, 0.9)(rng);
+  const Capture c = uniform_capture(2 * 65536 + 999, 6);
   Capture small = c;
   small.samples.resize(20000);
   Capture bad = c;
