@@ -17,16 +17,31 @@ std::mutex& fftw_planner_mutex() {
 }
 
 namespace {
-// FFTW_MEASURE wisdom of the correlation sizes (generated: bench/fft_wisdom_gen.cpp).
-constexpr const char* kCorrelationWisdom =
+// FFTW_MEASURE wisdom of each correlation size (generated: bench/fft_wisdom_gen.cpp), so a plan
+// imports its own size's entries only (about 1 KB; all sizes at once took 0.5 ms a plan).
+struct SizeWisdom {
+  std::size_t n;
+  const char* wisdom;
+};
+constexpr SizeWisdom kCorrelationWisdom[] = {
 #include "model/sim/fft_wisdom.inc"
-    ;
+};
+
+const char* wisdom_of(std::size_t nfft) {
+  for (const auto& w : kCorrelationWisdom) {
+    if (w.n == nfft) return w.wisdom;
+  }
+  return nullptr;
+}
 }  // namespace
 
 bool correlation_wisdom_applies() {
   const std::lock_guard<std::mutex> lock(fftw_planner_mutex());
-  fftw_forget_wisdom();
-  const bool ok = fftw_import_wisdom_from_string(kCorrelationWisdom) != 0;
+  bool ok = true;
+  for (const auto& w : kCorrelationWisdom) {
+    fftw_forget_wisdom();
+    ok = ok && fftw_import_wisdom_from_string(w.wisdom) != 0;
+  }
   fftw_forget_wisdom();
   return ok;
 }
@@ -41,7 +56,8 @@ CorrelationPlans plan_correlation(std::size_t nfft, double* in, fftw_complex* sp
   // Only the wisdom's entries, then nothing: FFTW keeps wisdom process-wide, and what other plans
   // left there must not decide these two, nor these entries any later plan.
   fftw_forget_wisdom();
-  if (fftw_import_wisdom_from_string(kCorrelationWisdom) != 0) {
+  const char* wisdom = wisdom_of(nfft);
+  if (wisdom && fftw_import_wisdom_from_string(wisdom) != 0) {
     p.fwd = fftw_plan_dft_r2c_1d(n, in, spec, FFTW_MEASURE | FFTW_WISDOM_ONLY);
     p.inv = fftw_plan_dft_c2r_1d(n, prod, out, FFTW_MEASURE | FFTW_WISDOM_ONLY);
   }
