@@ -110,7 +110,6 @@ PearsonBank::Plan& PearsonBank::plan(std::size_t nfft) {
   const CorrelationPlans made = plan_correlation(nfft, p->in.data(), spec, prod, p->out.data());
   p->fwd = made.fwd;
   p->inv = made.inv;
-  measured_ = made.measured;
   for (const auto& t : t_) {
     std::fill(p->in.begin(), p->in.end(), 0.0);
     std::copy(t.begin(), t.end(), p->in.begin());

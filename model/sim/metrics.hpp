@@ -61,9 +61,6 @@ class PearsonBank {
   void set_screening(bool on) { screen_ = on; }
   // Makes the transform plans of a max_lags search now (else the first search makes them).
   void prepare();
-  // Whether the last plan made came from the project's FFTW wisdom (plan_correlation); false
-  // before the first search.
-  bool measured_plans() const { return measured_; }
 
  private:
   struct Plan;
@@ -72,7 +69,6 @@ class PearsonBank {
   std::size_t n_ = 0;
   std::size_t max_lags_ = 0;
   bool screen_ = true;
-  bool measured_ = false;
   std::vector<std::vector<double>> t_;  // centred templates
   std::vector<double> tnorm_;           // sqrt(sum tc^2)
   std::map<std::size_t, std::unique_ptr<Plan>> plans_;
