@@ -201,19 +201,19 @@ int cmd_decode(const Args& args) {
       pass_error = std::current_exception();
     }
   });
-  FlatTopScan scan;
-  const std::function<void()> wait_for_pass = [&] {
+  const auto join_pass = [&] {
     pass.join();
     if (pass_error) std::rethrow_exception(pass_error);
+  };
+  FlatTopScan scan;
+  const std::function<void()> wait_for_pass = [&] {
+    join_pass();
     for (const auto& s : part_levels) scan.merge_levels(s);
   };
   try {
     return decode_opened(p, path, how, channel, block_option, jobs, cap, scan, wait_for_pass);
   } catch (...) {
-    if (pass.joinable()) {
-      pass.join();
-      if (pass_error) std::rethrow_exception(pass_error);
-    }
+    if (pass.joinable()) join_pass();  // the capture's error first
     throw;
   }
 }

@@ -32,24 +32,27 @@ char csv_separator(std::string_view line) {
 
 namespace {
 
-// strtod's value, end and ERANGE verdict for the number at p (C locale; [p, end) is the rest of a
-// NUL-terminated string), faster in the common case: std::from_chars (correctly rounded, as
-// glibc's strtod) when it reads a normal value; everything else (a leading '+' or space, hex,
-// inf, nan, zero, subnormals, overflow) goes to strtod itself. (Checked against strtod on 6 M
+// strtod's value, end and ERANGE verdict for the number at p (C locale) within [p, end), faster
+// in the common case: std::from_chars (correctly rounded, as glibc's strtod) when it reads a
+// normal value; everything else (a leading '+' or space, hex, inf, nan, zero, subnormals,
+// overflow) goes to strtod itself: on p when *end is the string's NUL (terminated), else on a
+// NUL-terminated copy of [p, end) (a cell inside its line). (Checked against strtod on 6 M
 // strings: random characters, doubles in %e/%g/%f/%a/%E/%+e, the subnormal and overflow edges.)
 struct Decimal {
   double value;
   const char* end;   // past the last character read
   bool range_error;  // strtod's ERANGE
 };
-Decimal read_decimal(const char* p, const char* end) {
+Decimal read_decimal(const char* p, const char* end, bool terminated) {
   double v = 0;
   const auto r = std::from_chars(p, end, v);
   if (r.ec == std::errc() && std::isnormal(v)) return {v, r.ptr, false};
+  const std::string copy = terminated ? std::string() : std::string(p, end);
+  const char* s = terminated ? p : copy.c_str();
   char* e = nullptr;
   errno = 0;
-  v = std::strtod(p, &e);
-  return {v, e, errno == ERANGE};
+  v = std::strtod(s, &e);
+  return {v, p + (e - s), errno == ERANGE};
 }
 
 }  // namespace
@@ -67,7 +70,7 @@ double csv_row_value(const std::string& line, int cell) {
     }
   }
   while (*p == ' ' || *p == '\t' || *p == '"') ++p;
-  return read_decimal(p, line.c_str() + line.size()).value;
+  return read_decimal(p, line.c_str() + line.size(), true).value;
 }
 namespace {
 
@@ -83,22 +86,12 @@ std::string_view trim(std::string_view s) {
 }
 
 // Strict number: the whole cell must parse (strtod also accepts nan/inf: refused by caller).
-// read_decimal's fast path reads the cell in place; its strtod fallback gets a NUL-terminated
-// copy of the cell (a cell is not one in its line).
 bool parse_number(std::string_view cell, double& out) {
   if (cell.empty()) return false;
-  const char* b = cell.data();
-  const char* e = b + cell.size();
-  double v = 0;
-  const auto r = std::from_chars(b, e, v);
-  if (r.ec == std::errc() && std::isnormal(v)) {
-    out = v;
-    return r.ptr == e;
-  }
-  const std::string copy(cell);
-  const Decimal d = read_decimal(copy.c_str(), copy.c_str() + copy.size());
+  const char* e = cell.data() + cell.size();
+  const Decimal d = read_decimal(cell.data(), e, false);
   out = d.value;
-  return d.end == copy.c_str() + copy.size() && !d.range_error;
+  return d.end == e && !d.range_error;
 }
 
 // The cells of one line, views into it. Separator (csv_separator): ';' if the line has one (a

@@ -62,17 +62,18 @@ CorrelationPlans plan_correlation(std::size_t nfft, double* in, fftw_complex* sp
     p.inv = fftw_plan_dft_c2r_1d(n, prod, out, FFTW_MEASURE | FFTW_WISDOM_ONLY);
   }
   fftw_forget_wisdom();
-  p.measured = p.fwd != nullptr && p.inv != nullptr;
-  if (!p.measured) {
+  const auto complete = [&] {
+    if (p.fwd && p.inv) return true;
     if (p.fwd) fftw_destroy_plan(p.fwd);
     if (p.inv) fftw_destroy_plan(p.inv);
+    p.fwd = p.inv = nullptr;
+    return false;
+  };
+  p.measured = complete();
+  if (!p.measured) {
     p.fwd = fftw_plan_dft_r2c_1d(n, in, spec, FFTW_ESTIMATE);
     p.inv = fftw_plan_dft_c2r_1d(n, prod, out, FFTW_ESTIMATE);
-  }
-  if (!p.fwd || !p.inv) {
-    if (p.fwd) fftw_destroy_plan(p.fwd);
-    if (p.inv) fftw_destroy_plan(p.inv);
-    throw std::bad_alloc();
+    if (!complete()) throw std::bad_alloc();
   }
   return p;
 }
