@@ -289,7 +289,9 @@ Capture uniform_capture(std::size_t n, std::uint64_t seed) {
 
 // The scan in parts (decode --jobs): a WAV's samples in consecutive runs of whole 65536-sample
 // blocks, part p's before part p + 1's, each part's blocks in order and those of the one-part
-// scan; a CSV is one part; more parts than blocks leave the rest unused.
+// scan; more parts than blocks leave the rest unused. A CSV's rows are cut into byte ranges of
+// whole lines (at least 64 KiB each; 70000 rows are 2.2 MB), each part's rows in blocks of at
+// most 4096.
 TEST(StreamingDecode, TheOpenScanInPartsSeesEveryBlockOnce) {
   const Capture c = uniform_capture(3 * 65536 + 1234, 5);
   Capture small = c;
@@ -321,11 +323,138 @@ TEST(StreamingDecode, TheOpenScanInPartsSeesEveryBlockOnce) {
         EXPECT_EQ(sizes, (std::vector<std::size_t>{65536, 65536, 65536, 1234})) << name << " parts " << parts;
         EXPECT_EQ(used, std::min<std::size_t>(parts, 4)) << name;
       } else {
-        EXPECT_EQ(used, 1u) << name;
+        EXPECT_EQ(used, parts) << name;
+        for (const std::size_t b : sizes) EXPECT_LE(b, 4096u) << name;
+        if (parts == 1) {
+          EXPECT_EQ(sizes.front(), 4096u) << "one part: the blocks of 4096 rows";
+        }
       }
       std::vector<double> again(whole.size());  // the samples still read from the start
       EXPECT_EQ(src.read(again), whole.size());
       EXPECT_EQ(again, whole);
+    }
+  }
+}
+
+// A CSV opened in parts (each part's rows checked on a thread of its own; time must increase
+// across the cuts too) accepts what read_capture accepts, with the same samples, rate and start,
+// and refuses what it refuses with its message (the first error in the file, its line): bad
+// cells, time that does not increase, an uneven grid, an empty line, at rows around every cut
+// of 2, 3 and 4 parts, the first row after the header and the last; a truncated Record Length,
+// a blank last line; valid: CRLF lines, no newline at the end, a 2.5 MB header line.
+TEST(StreamingDecode, ACsvInPartsAcceptsAndRefusesAsOnePass) {
+  const Capture c = uniform_capture(9000, 8);  // 290 kB: up to 4 parts
+  const std::string text = capture_csv(c);
+  std::vector<std::string> lines;
+  for (std::size_t b = 0, e; (e = text.find('\n', b)) != std::string::npos; b = e + 1) lines.push_back(text.substr(b, e - b));
+  const std::size_t head = lines.size() - c.samples.size();  // lines before the first data row
+  auto join = [](const std::vector<std::string>& ls, const std::string& eol = "\n") {
+    std::string t;
+    for (const auto& l : ls) t += l + eol;
+    return t;
+  };
+  auto time_cell = [&](std::size_t row) { return lines[head + row].substr(0, lines[head + row].find(',')); };
+  std::vector<std::pair<std::string, std::string>> cases = {
+      {"valid", text},
+      {"crlf", join(lines, "\r\n")},
+      {"no_final_newline", text.substr(0, text.size() - 1)},
+      {"truncated", join(std::vector<std::string>(lines.begin(), lines.end() - 1))},
+      {"blank_last_line", text + "\n"}};
+  {
+    std::vector<std::string> ls = lines;
+    ls.insert(ls.begin() + 1, "Comment," + std::string(2500000, 'x'));
+    cases.emplace_back("long_header_line", join(ls));
+  }
+  std::vector<std::size_t> rows = {1, c.samples.size() - 1};
+  for (std::size_t np : {2, 3, 4}) {
+    for (std::size_t p = 1; p < np; ++p) {
+      const std::size_t r = 1 + (c.samples.size() - 1) * p / np;
+      for (std::size_t k = r - 2; k <= r + 2; ++k) rows.push_back(k);
+    }
+  }
+  for (const std::size_t k : rows) {
+    const std::string at = std::to_string(k);
+    auto edit = [&](const std::string& kind, const std::string& line) {
+      std::vector<std::string> ls = lines;
+      ls[head + k] = line;
+      cases.emplace_back(kind + at, join(ls));
+    };
+    edit("bad_value", time_cell(k) + ",abc");
+    edit("nan", time_cell(k) + ",nan");
+    edit("time_repeats", time_cell(k - 1) + ",0.5");
+    char t[64];
+    std::snprintf(t, sizeof t, "%.9e,0.5", (static_cast<double>(k) + 0.4) / c.sample_rate);
+    edit("uneven", t);
+    std::vector<std::string> ls = lines;
+    ls.insert(ls.begin() + static_cast<std::ptrdiff_t>(head + k), "");
+    cases.emplace_back("empty_line" + at, join(ls));
+  }
+  std::size_t refused = 0;
+  for (const auto& [name, bytes] : cases) {
+    const std::string p = write("cut_" + name + ".csv", bytes);
+    std::string want;
+    Capture whole;
+    try {
+      whole = read_capture(p);
+    } catch (const InputError& e) {
+      want = e.what();
+    }
+    refused += !want.empty();
+    for (std::size_t parts : {1, 2, 3, 4}) {
+      SCOPED_TRACE(name + ", parts " + std::to_string(parts));
+      std::vector<std::vector<double>> seen(parts);
+      std::string got;
+      try {
+        CaptureSource src(
+            p, {}, [&](std::size_t part, std::span<const double> x) { seen.at(part).insert(seen[part].end(), x.begin(), x.end()); },
+            parts);
+        std::vector<double> all;
+        for (const auto& s : seen) all.insert(all.end(), s.begin(), s.end());
+        EXPECT_EQ(all, whole.samples);
+        EXPECT_EQ(src.sample_rate(), whole.sample_rate);
+        EXPECT_EQ(src.t0(), whole.t0);
+        std::vector<double> again(whole.samples.size() + 1);
+        EXPECT_EQ(src.read(again), whole.samples.size());
+        again.pop_back();
+        EXPECT_EQ(again, whole.samples);
+      } catch (const InputError& e) {
+        got = e.what();
+      }
+      EXPECT_EQ(got, want);
+    }
+  }
+  EXPECT_EQ(refused, cases.size() - 4) << "every case but the 4 valid ones is refused";
+  // A column of samples alone at a given rate (27000 rows, 270 kB): the same samples, or the
+  // same refusal.
+  std::string column;
+  for (int r = 0; r < 3; ++r) {
+    for (const double v : c.samples) column += std::to_string(v) + "\n";
+  }
+  const std::size_t mid = column.size() / 2;
+  const std::size_t cut = column.find('\n', mid) + 1;
+  for (const auto& [name, bytes] : std::vector<std::pair<std::string, std::string>>{
+           {"column", column}, {"column_bad", column.substr(0, cut) + "x\n" + column.substr(cut)}}) {
+    const std::string p = write(name + ".csv", bytes);
+    const CaptureRead how{.channel = 1, .sample_rate = 1e6};
+    std::string want, got;
+    Capture whole;
+    try {
+      whole = read_capture(p, how);
+    } catch (const InputError& e) {
+      want = e.what();
+    }
+    EXPECT_EQ(want.empty(), name == "column") << want;
+    for (std::size_t parts : {1, 2, 4}) {
+      try {
+        CaptureSource src(p, how, [](std::size_t, std::span<const double>) {}, parts);
+        std::vector<double> all(whole.samples.size());
+        EXPECT_EQ(src.read(all), whole.samples.size());
+        EXPECT_EQ(all, whole.samples) << name << " parts " << parts;
+        EXPECT_EQ(src.sample_rate(), 1e6);
+      } catch (const InputError& e) {
+        got = e.what();
+      }
+      EXPECT_EQ(got, want) << name << " parts " << parts;
     }
   }
 }

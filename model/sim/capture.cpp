@@ -57,20 +57,21 @@ Decimal read_decimal(const char* p, const char* end, bool terminated) {
 
 }  // namespace
 
-double csv_row_value(const std::string& line, int cell) {
+double csv_row_value(std::string_view line, int cell) {
   const char sep = csv_separator(line);
-  const char* p = line.c_str();
+  const char* p = line.data();
+  const char* const end = p + line.size();
   for (int c = 0; c < cell; ++c) {  // past the cells before it
     if (sep != '\0') {
-      while (*p != '\0' && *p != sep) ++p;
-      if (*p == sep) ++p;
+      while (p != end && *p != sep) ++p;
+      if (p != end) ++p;
     } else {  // whitespace-separated: past the next token
-      while (*p == ' ' || *p == '\t') ++p;
-      while (*p != '\0' && *p != ' ' && *p != '\t') ++p;
+      while (p != end && (*p == ' ' || *p == '\t')) ++p;
+      while (p != end && *p != ' ' && *p != '\t') ++p;
     }
   }
-  while (*p == ' ' || *p == '\t' || *p == '"') ++p;
-  return read_decimal(p, line.c_str() + line.size(), true).value;
+  while (p != end && (*p == ' ' || *p == '\t' || *p == '"')) ++p;
+  return read_decimal(p, end, false).value;
 }
 namespace {
 
@@ -228,7 +229,7 @@ CsvCaptureScan::CsvCaptureScan(std::string origin, const CaptureRead& how)
   }
 }
 
-bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
+bool CsvCaptureScan::line(std::string_view text, double& t, double& v) {
   ++lineno_;
   if (trim(text).empty()) {
     if (data_) fail_at(origin_, lineno_, "empty line inside the data rows");
@@ -311,6 +312,22 @@ bool CsvCaptureScan::line(const std::string& text, double& t, double& v) {
   t = val[0];
   v = val[1];
   return true;
+}
+
+CsvCaptureScan CsvCaptureScan::continuation() const {
+  CsvCaptureScan part(origin_, CaptureRead{.channel = channel_, .sample_rate = given_rate_});
+  part.channels_ = channels_;
+  part.no_time_ = no_time_;
+  part.data_ = data_;
+  return part;
+}
+
+void CsvCaptureScan::append(const CsvCaptureScan& part) {
+  lineno_ += part.lineno_;
+  if (part.rows_ == 0) return;
+  rows_ += part.rows_;
+  last_data_line_ = lineno_ - (part.lineno_ - part.last_data_line_);
+  t_last_ = no_time_ ? static_cast<double>(rows_ - 1) / given_rate_ : part.t_last_;
 }
 
 void CsvCaptureScan::finish() {

@@ -16,7 +16,68 @@ namespace ranging {
 
 namespace {
 constexpr std::size_t kWavBlockBytes = std::size_t{1} << 20;
-}
+constexpr std::size_t kCsvScanRows = 4096;                   // rows per block of the open's scan
+constexpr std::size_t kCsvPartBytes = std::size_t{1} << 16;  // the least bytes of a CSV part
+}  // namespace
+
+// The lines of bytes [begin, end) of a file, split as std::getline splits them: at each '\n'
+// (not part of the line; a '\r' before it is), the last one without a '\n' if the range does not
+// end with one. Read through one buffer of 1 MiB (grown for a longer line); a line is a view into
+// it, valid until the next call.
+class LineReader {
+ public:
+  LineReader(std::ifstream& in, std::size_t begin, std::size_t end, const std::string& origin)
+      : in_(in), origin_(origin), buf_(kWavBlockBytes, '\0'), file_(begin), end_(end), offset_(begin) {
+    in_.clear();
+    in_.seekg(static_cast<std::streamoff>(begin));
+  }
+  bool next(std::string_view& line) {
+    for (;;) {
+      const char* b = buf_.data() + at_;
+      if (const void* nl = std::memchr(b, '\n', len_ - at_)) {
+        const auto n = static_cast<std::size_t>(static_cast<const char*>(nl) - b);
+        line = std::string_view(b, n);
+        take(n + 1);
+        return true;
+      }
+      if (file_ == end_) {  // the range's last line, without its '\n'
+        if (at_ == len_) return false;
+        line = std::string_view(b, len_ - at_);
+        take(len_ - at_);
+        return true;
+      }
+      refill();
+    }
+  }
+  std::size_t line_at() const { return line_at_; }  // file offset of the line next() gave last
+  std::size_t offset() const { return offset_; }    // file offset of the line it gives next
+
+ private:
+  std::ifstream& in_;
+  const std::string& origin_;
+  std::string buf_;
+  std::size_t at_ = 0, len_ = 0;         // the unread bytes: buf_[at_, len_)
+  std::size_t file_, end_, offset_, line_at_ = 0;  // file_: offset of buf_[len_]
+  void take(std::size_t n) {
+    line_at_ = offset_;
+    at_ += n;
+    offset_ += n;
+  }
+  void refill() {  // the partial line to the front, then as many bytes as fit
+    std::memmove(buf_.data(), buf_.data() + at_, len_ - at_);
+    len_ -= at_;
+    at_ = 0;
+    if (len_ == buf_.size()) buf_.resize(2 * buf_.size());
+    const std::size_t want = std::min(buf_.size() - len_, end_ - file_);
+    in_.read(buf_.data() + len_, static_cast<std::streamsize>(want));
+    if (static_cast<std::size_t>(in_.gcount()) != want) {
+      if (in_.bad()) throw InputError(origin_ + ": cannot read the capture file");
+      throw InputError(origin_ + ": changed while it was read (shorter than at open)");
+    }
+    len_ += want;
+    file_ += want;
+  }
+};
 
 CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how,
                              const std::function<void(std::span<const double>)>& scan)
@@ -32,8 +93,6 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, co
 CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& part_scan,
                              std::size_t parts, Deferred)
     : path_(path) {
-  const auto scan = [&](std::span<const double> x) { part_scan(0, x); };  // a CSV: one part
-  std::vector<double> block;  // scan's samples
   std::string ext;
   if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
@@ -51,40 +110,13 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, co
   if (!in_) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
   const std::size_t file_size = static_cast<std::size_t>(fs::file_size(path, ec));
   if (csv_) {
-    CsvCaptureScan rows(path, how);
-    std::string line;
-    double t = 0, v = 0;
-    while (std::getline(in_, line)) {
-      if (!rows.line(line, t, v) || !part_scan) continue;
-      block.push_back(v);
-      if (block.size() == 4096) {
-        scan(block);
-        block.clear();
-      }
+    file_size_ = file_size;
+    if (parts > 1) {
+      csv_parts(how, part_scan, parts);
+    } else {
+      CsvCaptureScan rows(path, how);
+      csv_pass(rows, part_scan);
     }
-    if (in_.bad()) throw InputError(path + ": cannot read the capture file");
-    rows.finish();
-    if (part_scan && !block.empty()) scan(block);
-    // Second pass: every row on the uniform grid. The rows are known to be well formed now, and
-    // every line from the first data row on is one (an empty line among them was refused), so
-    // only the time cell is read, as read() reads a cell.
-    in_.clear();
-    in_.seekg(0);
-    if (rows.has_time()) {
-      std::size_t n = 0, lineno = 0;
-      while (std::getline(in_, line)) {
-        if (++lineno < rows.first_data_line()) continue;
-        rows.check_grid(n++, csv_row_value(line, 0), lineno);
-      }
-    }
-    rate_ = rows.sample_rate();
-    t0_ = rows.t0();
-    n_ = rows.rows();
-    meta_ = rows.meta();
-    first_data_line_ = rows.first_data_line();
-    channels_ = rows.channels();
-    cell_ = rows.value_cell();
-    file_rate_ = rows.has_time() ? rate_ : 0;
   } else {
     wav_ = parse_wav_layout(
         [&](std::size_t at, std::size_t len) {
@@ -112,6 +144,151 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, co
   }
   merge_capture_sidecar(meta_, path);
   if (!pending_) seek_start();
+}
+
+void CaptureSource::csv_pass(CsvCaptureScan& rows, const PartScan& scan) {
+  LineReader lines(in_, 0, file_size_, path_);
+  std::vector<double> block;
+  std::string_view line;
+  double t = 0, v = 0;
+  while (lines.next(line)) {
+    if (!rows.line(line, t, v)) continue;
+    if (rows.rows() == 1) data_at_ = lines.line_at();
+    if (!scan) continue;
+    block.push_back(v);
+    if (block.size() == kCsvScanRows) {
+      scan(0, block);
+      block.clear();
+    }
+  }
+  rows.finish();
+  if (scan && !block.empty()) scan(0, block);
+  // Every row on the uniform grid. The rows are known to be well formed now, and every line
+  // from the first data row on is one (an empty line among them was refused), so only the time
+  // cell is read, as read() reads a cell.
+  if (rows.has_time()) {
+    LineReader again(in_, data_at_, file_size_, path_);
+    for (std::size_t n = 0; again.next(line); ++n) rows.check_grid(n, csv_row_value(line, 0), rows.first_data_line() + n);
+  }
+  csv_done(rows);
+}
+
+void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std::size_t parts) {
+  // The header, up to the first data row, on this thread: the columns, the metadata.
+  CsvCaptureScan rows(path_, how);
+  LineReader lines(in_, 0, file_size_, path_);
+  std::string_view line;
+  double t = 0, v0 = 0;
+  bool data = false;
+  while (!data && lines.next(line)) data = rows.line(line, t, v0);
+  if (!data) {  // no data row: finish() says so
+    rows.finish();
+    throw std::logic_error("CaptureSource: a CSV without data rows passed");
+  }
+  data_at_ = lines.line_at();
+  // The rows after the first: cut at line starts into parts of at least kCsvPartBytes.
+  const std::size_t rest = lines.offset();
+  const std::size_t np = std::clamp<std::size_t>((file_size_ - rest) / kCsvPartBytes, 1, parts);
+  std::vector<std::size_t> cut(np + 1, file_size_);
+  cut[0] = rest;
+  {
+    std::ifstream probe(path_, std::ios::binary);
+    std::string chunk;
+    for (std::size_t p = 1; p < np; ++p) {
+      std::size_t at = std::max(cut[p - 1], rest + (file_size_ - rest) / np * p);
+      // the first line start at or after `at`: past the next '\n' from at - 1 on
+      probe.clear();
+      probe.seekg(static_cast<std::streamoff>(at - 1));
+      for (bool found = false; !found && at - 1 < file_size_;) {
+        chunk.resize(std::min<std::size_t>(4096, file_size_ - (at - 1)));
+        probe.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+        const auto got = static_cast<std::size_t>(probe.gcount());
+        if (got == 0) break;
+        if (const void* nl = std::memchr(chunk.data(), '\n', got)) {
+          at += static_cast<std::size_t>(static_cast<const char*>(nl) - chunk.data());
+          found = true;
+        } else {
+          at += got;
+        }
+      }
+      cut[p] = std::min(at, file_size_);
+    }
+  }
+  // Each part's rows through a continuation of the scan; an error marks the part bad.
+  std::vector<CsvCaptureScan> part(np, rows.continuation());
+  std::vector<char> bad(np, 0);
+  parallel_items(np, np, [&](std::size_t p, std::size_t) {
+    std::ifstream own;
+    if (p > 0) {
+      own.open(path_, std::ios::binary);
+      if (!own) throw InputError(path_ + ": cannot open the capture file: " + std::strerror(errno));
+    }
+    LineReader lr(p > 0 ? own : in_, cut[p], cut[p + 1], path_);
+    std::vector<double> block;
+    if (p == 0 && scan) block.push_back(v0);
+    std::string_view ln;
+    double tp = 0, vp = 0;
+    for (;;) {
+      try {
+        if (!lr.next(ln)) break;
+        (void)part[p].line(ln, tp, vp);
+      } catch (const InputError&) {
+        bad[p] = 1;
+        return;
+      }
+      if (!scan) continue;
+      block.push_back(vp);
+      if (block.size() == kCsvScanRows) {
+        scan(p, block);
+        block.clear();
+      }
+    }
+    if (scan && !block.empty()) scan(p, block);
+  });
+  // The parts' rows after the first, in order; then the file's checks and the grid, by part.
+  // (Time increases across a cut too when every row is within 2 % of a step of its grid point.)
+  bool ok = std::find(bad.begin(), bad.end(), 1) == bad.end();
+  for (std::size_t p = 0; ok && p < np; ++p) rows.append(part[p]);
+  if (ok) {
+    try {
+      rows.finish();
+    } catch (const InputError&) {
+      ok = false;
+    }
+  }
+  if (ok && rows.has_time()) {
+    std::vector<std::size_t> n0(np, 1);  // row index of each part's first row
+    for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + part[p - 1].rows();
+    parallel_items(np, np, [&](std::size_t p, std::size_t) {
+      std::ifstream own;
+      if (p > 0) own.open(path_, std::ios::binary);
+      LineReader lr(p > 0 ? own : in_, cut[p], cut[p + 1], path_);
+      std::string_view ln;
+      try {
+        for (std::size_t n = n0[p]; lr.next(ln); ++n) rows.check_grid(n, csv_row_value(ln, 0), 0);
+      } catch (const InputError&) {
+        bad[p] = 1;
+      }
+    });
+    ok = std::find(bad.begin(), bad.end(), 1) == bad.end();
+  }
+  if (!ok) {  // the message, as one pass finds it
+    CsvCaptureScan again(path_, how);
+    csv_pass(again, {});
+    throw std::logic_error("CaptureSource: " + path_ + ": a part of the CSV was refused, but not the whole file");
+  }
+  csv_done(rows);
+}
+
+void CaptureSource::csv_done(const CsvCaptureScan& rows) {
+  rate_ = rows.sample_rate();
+  t0_ = rows.t0();
+  n_ = rows.rows();
+  meta_ = rows.meta();
+  first_data_line_ = rows.first_data_line();
+  channels_ = rows.channels();
+  cell_ = rows.value_cell();
+  file_rate_ = rows.has_time() ? rate_ : 0;
 }
 
 void CaptureSource::finish() {
@@ -161,9 +338,8 @@ void CaptureSource::rewind() {
 void CaptureSource::seek_start() {
   in_.clear();
   pos_ = 0;
-  lineno_ = 0;
   if (csv_) {
-    in_.seekg(0);
+    lines_ = std::make_unique<LineReader>(in_, data_at_, file_size_, path_);
   } else {
     in_.seekg(static_cast<std::streamoff>(wav_.body));
   }
@@ -173,10 +349,8 @@ std::size_t CaptureSource::read(std::span<double> out) {
   if (!finished_) throw std::logic_error("CaptureSource: read() before finish()");
   std::size_t k = 0;
   if (csv_) {
-    std::string line;
-    while (k < out.size() && pos_ < n_ && std::getline(in_, line)) {
-      ++lineno_;
-      if (lineno_ < first_data_line_) continue;
+    std::string_view line;
+    while (k < out.size() && pos_ < n_ && lines_->next(line)) {
       // The rows were validated at open: the channel's cell is a finite number.
       out[k++] = csv_row_value(line, cell_);
       ++pos_;

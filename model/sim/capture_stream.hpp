@@ -7,7 +7,10 @@
 //        data chunk in blocks (one pass to check them for NaN/Inf at open for float WAVs).
 //   CSV: open() reads the file once for the header, the rows' syntax and the time grid's span
 //        (CsvCaptureScan), a second time for the uniform-grid check (every row within 2 % of a
-//        step); read() parses the rows again.
+//        step); read() parses the rows again. Lines come through one 1 MiB buffer (LineReader).
+//        With parts > 1 both passes run on threads over byte ranges of whole lines after the
+//        first data row (at least 64 KiB each); an error in any part sends the file through the
+//        one-thread pass, which names the first error and its line as read_capture does.
 // The pieces read_capture shares with it (one implementation of every check):
 //   CsvCaptureScan  the CSV line grammar, row by row (header lines, metadata keys, strict numbers,
 //                   increasing time), then finish() (Record Length, row count, sample rate) and
@@ -30,7 +33,7 @@ namespace ranging {
 // and spaces). csv_row_value: cell `cell` (0-based: 1 is the first channel after the time) of a
 // data row that CsvCaptureScan validated.
 char csv_separator(std::string_view line);
-double csv_row_value(const std::string& line, int cell = 1);
+double csv_row_value(std::string_view line, int cell = 1);
 
 class CsvCaptureScan {
  public:
@@ -38,7 +41,15 @@ class CsvCaptureScan {
   // rows of one column are samples at that rate (capture.hpp)
   explicit CsvCaptureScan(std::string origin, const CaptureRead& how = {});
   // One line of the file (without its newline): true for a data row (t, v set).
-  bool line(const std::string& text, double& t, double& v);
+  bool line(std::string_view text, double& t, double& v);
+  // For a reader that cuts the data rows into parts (CaptureSource, on threads): a scan of the
+  // rows that follow this one's first data row, with its columns and channel; its rows and line
+  // numbers count from the part's first line, and for rows of samples alone its t from 0. An
+  // error it throws says only that the part is bad (the reader finds the message by one pass).
+  CsvCaptureScan continuation() const;
+  // The rows a continuation read, after this scan's: rows, lines and the time span as if this
+  // scan had read them (that time increases across is left to check_grid, which implies it).
+  void append(const CsvCaptureScan& part);
   void finish();  // after the last line: the file-level checks; sample_rate() and t0() valid after it
   void check_grid(std::size_t n, double t, std::size_t line) const;  // row n (0-based) at `line`
   std::size_t lineno() const { return lineno_; }
@@ -87,6 +98,8 @@ void wav_samples(const char* p, std::size_t frames, const WavLayout& w, const st
 // The sidecar STEM.json of path (if any) fills what meta lacks (read_capture's rule).
 void merge_capture_sidecar(CaptureMeta& meta, const std::string& path);
 
+class LineReader;  // capture_stream.cpp: a file's lines through one buffer
+
 class CaptureSource {
  public:
   // Validates the whole file (InputError); how: as read_capture. scan, when given, sees every
@@ -132,14 +145,23 @@ class CaptureSource {
   std::size_t n_ = 0, pos_ = 0;
   CaptureMeta meta_;
   WavLayout wav_;
-  std::size_t first_data_line_ = 0, lineno_ = 0;
+  std::size_t first_data_line_ = 0;
+  std::size_t file_size_ = 0, data_at_ = 0;  // CSV: bytes at open, offset of the first data row
   std::ifstream in_;
+  std::unique_ptr<LineReader> lines_;  // CSV: read()'s lines, from the first data row
   std::string buf_;
   PartScan pending_scan_;            // Deferred: finish()'s scan
   std::size_t pending_parts_ = 1;
   bool pending_ = false;             // Deferred: the WAV's pass has not run
   bool finished_ = false;            // finish() has run
   void seek_start();  // the next read() gives sample 0
+  // The CSV's open pass on the calling thread: every line in order through `rows`, the scan in
+  // blocks of 4096 rows (part 0), finish(), the grid check (read_capture's checks and order).
+  void csv_pass(CsvCaptureScan& rows, const PartScan& scan);
+  // The same with the data rows cut into up to `parts` byte ranges of whole lines, one thread
+  // each (part p's rows before part p + 1's); on any error, csv_pass names it.
+  void csv_parts(const CaptureRead& how, const PartScan& scan, std::size_t parts);
+  void csv_done(const CsvCaptureScan& rows);  // the header's accessors from the finished scan
   // The WAV's pass over every sample (validation of a float WAV, the scan) in parts.
   void wav_pass(const PartScan& scan, std::size_t parts);
   // frames [i0, i0 + m) of the data chunk from `in` (positioned there) into out, through buf
