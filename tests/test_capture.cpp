@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <sstream>
 
 #include "model/sim/capture.hpp"
@@ -664,5 +665,41 @@ TEST(Capture, CsvNumbersAreReadExactlyAsStrtodReadsThem) {
     } catch (const InputError& e) {
       EXPECT_FALSE(ok) << "refused a cell strtod reads: " << e.what();
     }
+  }
+}
+
+// The numbers of real exports (and many that are not): random doubles of every magnitude printed
+// as %.Ne, %.NE, %.Nf, %.Ng with 0..20 digits, negative, with '+' exponents, short mantissas,
+// 19- and 20-digit integers, and 2^53 +- 1: the CSV's value is strtod's, bit for bit (the rows'
+// time cells are the plain grid).
+TEST(Capture, RandomCsvNumbersAreReadExactlyAsStrtodReadsThem) {
+  std::mt19937_64 rng(11);
+  std::vector<std::string> cells = {"9007199254740992", "9007199254740993", "9007199254740991", "1234567890123456789",
+                                    "12345678901234567890", "0.1e-22", "1e22", "1e23", "1e-22", "1e-23", "-1.5E+3",
+                                    "0.000000000000000000001", "2.2250738585072014e-308"};
+  char buf[96];
+  for (int i = 0; i < 20000; ++i) {
+    const double mag = std::ldexp(std::uniform_real_distribution<double>(0.5, 1.0)(rng),
+                                  std::uniform_int_distribution<int>(-120, 120)(rng));
+    const double v = (rng() & 1) ? -mag : mag;
+    const int prec = std::uniform_int_distribution<int>(0, 20)(rng);
+    const char* fmt[] = {"%.*e", "%.*E", "%.*f", "%.*g"};
+    std::snprintf(buf, sizeof buf, fmt[rng() % 4], prec, v);
+    cells.emplace_back(buf);
+  }
+  std::string text;
+  for (std::size_t n = 0; n < cells.size(); ++n) text += std::to_string(n) + "," + cells[n] + "\n";
+  const Capture c = parse_capture_csv(text, "r.csv", {});
+  ASSERT_EQ(c.samples.size(), cells.size());
+  const testing_support::ScratchDir scratch("capture_rnd", ::testing::TempDir());
+  const fs::path p = scratch.path() / "rnd.csv";
+  write(p.string(), text);
+  CaptureSource src(p.string());
+  std::vector<double> streamed(cells.size());
+  ASSERT_EQ(src.read(streamed), cells.size());
+  for (std::size_t n = 0; n < cells.size(); ++n) {
+    const double want = std::strtod(cells[n].c_str(), nullptr);
+    EXPECT_EQ(std::memcmp(&c.samples[n], &want, sizeof want), 0) << cells[n];
+    EXPECT_EQ(std::memcmp(&streamed[n], &want, sizeof want), 0) << cells[n];
   }
 }

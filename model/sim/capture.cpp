@@ -4,6 +4,7 @@
 #include <bit>
 #include <cctype>
 #include <charconv>
+#include <cstdint>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -43,8 +44,46 @@ struct Decimal {
   const char* end;   // past the last character read
   bool range_error;  // strtod's ERANGE
 };
+// Clinger's fast path first: [-]D+[.D+][(e|E)[+|-]D{1,3}] with at most 19 digits whose integer
+// m is at most 2^53, scaled by 10^k, |k| <= 22. m and 10^|k| are exact doubles, so one IEEE
+// multiply or divide rounds the exact value m 10^k once, to nearest: strtod's correctly rounded
+// value. A scope's %.9e cells all take it; anything else, or m == 0, goes on to from_chars.
+bool fast_decimal(const char* p, const char* end, double& v, const char*& stop) {
+  static constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                        1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const auto digit = [&](const char* q) { return q != end && static_cast<unsigned>(*q - '0') < 10u; };
+  const bool neg = p != end && *p == '-';
+  const char* q = p + (neg ? 1 : 0);
+  std::uint64_t m = 0;
+  int digits = 0, k = 0;
+  if (!digit(q)) return false;
+  for (; digit(q); ++q, ++digits) m = 10 * m + static_cast<unsigned>(*q - '0');
+  if (q != end && *q == '.') {
+    if (!digit(++q)) return false;
+    for (; digit(q); ++q, ++digits, --k) m = 10 * m + static_cast<unsigned>(*q - '0');
+  }
+  if (digits > 19 || m == 0 || m > (std::uint64_t{1} << 53)) return false;
+  if (q != end && (*q == 'e' || *q == 'E')) {
+    const char* x = q + 1;
+    const bool xneg = x != end && *x == '-';
+    if (x != end && (*x == '-' || *x == '+')) ++x;
+    int e = 0, n = 0;
+    for (; digit(x) && n < 4; ++x, ++n) e = 10 * e + (*x - '0');
+    if (n == 0 || n == 4) return false;  // no exponent digits (from_chars stops before the 'e'), or many
+    k += xneg ? -e : e;
+    q = x;
+  }
+  if (k < -22 || k > 22) return false;
+  const double a = static_cast<double>(m);
+  v = k < 0 ? a / kPow10[-k] : a * kPow10[k];
+  if (neg) v = -v;
+  stop = q;
+  return true;
+}
+
 Decimal read_decimal(const char* p, const char* end, bool terminated) {
   double v = 0;
+  if (const char* stop = nullptr; fast_decimal(p, end, v, stop)) return {v, stop, false};
   const auto r = std::from_chars(p, end, v);
   if (r.ec == std::errc() && std::isnormal(v)) return {v, r.ptr, false};
   const std::string copy = terminated ? std::string() : std::string(p, end);
@@ -61,16 +100,20 @@ double csv_row_value(std::string_view line, int cell) {
   const char sep = csv_separator(line);
   const char* p = line.data();
   const char* const end = p + line.size();
-  for (int c = 0; c < cell; ++c) {  // past the cells before it
-    if (sep != '\0') {
+  if (sep == '\0') {  // whitespace-separated: the cell-th token, split as split_cells splits
+    const auto space = [](char ch) { return std::isspace(static_cast<unsigned char>(ch)) != 0; };
+    for (int c = 0;; ++c) {
+      while (p != end && space(*p)) ++p;
+      if (c == cell) break;
+      while (p != end && !space(*p)) ++p;
+    }
+  } else {
+    for (int c = 0; c < cell; ++c) {  // past the cells before it
       while (p != end && *p != sep) ++p;
       if (p != end) ++p;
-    } else {  // whitespace-separated: past the next token
-      while (p != end && (*p == ' ' || *p == '\t')) ++p;
-      while (p != end && *p != ' ' && *p != '\t') ++p;
     }
+    while (p != end && (*p == ' ' || *p == '\t' || *p == '\r' || *p == '"')) ++p;  // what trim drops
   }
-  while (p != end && (*p == ' ' || *p == '\t' || *p == '"')) ++p;
   return read_decimal(p, end, false).value;
 }
 namespace {
