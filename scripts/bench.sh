@@ -8,13 +8,14 @@
 #     (scripts/bench_sosfilt.py) and vs SystemC sc_fixed / sc_fix (bench/bench_fixed_point);
 #   the Verilator RTL of receiver_top vs the model (tb/bench_receiver_top, then its
 #     profile-guided build tb/bench_receiver_top_pgo);
-#   streaming decode of 10 M and 100 M-sample WAV captures (/usr/bin/time -v: CPU time, peak RSS;
-#     --jobs 2 wall time: median and fastest of BENCH_DECODE_REPEATS, default 5);
+#   streaming decode of 10 M and 100 M-sample WAV captures and a 2 M-row CSV (/usr/bin/time -v:
+#     CPU time, peak RSS; --jobs 2 wall time: median and fastest of BENCH_DECODE_REPEATS, default 5);
 #   scenes per sample: default (float, fixed, fixed without metrics) and minimal (summary.json samples_simulated),
 #     BENCH_ROUNDS (default 3) interleaved rounds, the median reported;
 #   simulate --jobs 1 against --jobs 2 (wall time: the only clock that shows a parallel speedup);
 #   and the ratios. Rates are per second of CPU time (one core), so a busy machine does not
-#   scale them down. BENCH_DECODE_SAMPLES="1e7 1e8" sets the decode lengths (disk: 4 bytes/sample).
+#   scale them down. BENCH_DECODE_SAMPLES="1e7 1e8" sets the WAV decode lengths (disk: 4 bytes a
+#   sample), BENCH_DECODE_CSV_ROWS="2e6" the CSV's (32 bytes a row).
 #   scripts/bench.sh [BUILD_DIR]      (default build/; configured with hardware and bench ON)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -51,13 +52,14 @@ printf '%s\n' "name: train" "medium: {temperature_c: 20}" "transducers: {}" "geo
   "noise: {noise_v: 0.002, seed: 1}" >"$T/train.yaml"
 "$B"/tool/ranging simulate "$T/train.yaml" --out "$T/train" --write-captures --quiet >/dev/null
 : >"$T/decode.txt"
-for n in ${BENCH_DECODE_SAMPLES:-1e7 1e8}; do
-  $PY scripts/make_long_capture.py "$T/train/captures/Gold4_500mm_r1.wav" "$n" "$T/long.wav" 9
-  /usr/bin/time -v "$B"/tool/ranging decode "$T/long.wav" --json >"$T/long.out" 2>"$T/long.time"
+decode_bench() {  # N FILE (.wav or .csv, made by scripts/make_long_capture.py)
+  local n=$1 f=$2
+  $PY scripts/make_long_capture.py "$T/train/captures/Gold4_500mm_r1.wav" "$n" "$f" 9
+  /usr/bin/time -v "$B"/tool/ranging decode "$f" --json >"$T/long.out" 2>"$T/long.time"
   # the bursts' metrics on 2 threads (decode --jobs 2, the same output): wall seconds by
   # time.perf_counter (/usr/bin/time counts 10 ms steps, 5 % of a 10 M-sample decode), the median
   # and the fastest of BENCH_DECODE_REPEATS (default 5) runs
-  $PY - "$B/tool/ranging" "$T/long.wav" "${BENCH_DECODE_REPEATS:-5}" >"$T/long2.time" <<'PYEOF'
+  $PY - "$B/tool/ranging" "$f" "${BENCH_DECODE_REPEATS:-5}" >"$T/long2.time" <<'PYEOF'
 import subprocess, sys, time
 t = []
 for _ in range(int(sys.argv[3])):
@@ -76,10 +78,13 @@ n = float(sys.argv[1])
 dets = len(json.load(open(sys.argv[3]))["detections"])
 rss = g("Maximum resident set size") / 1024
 w2, w2min = (float(v) for v in open(sys.argv[4]).read().split())
-print(f"{n:.0e} {cpu:.3f} {n / cpu / 1e6:.2f} {rss:.1f} {dets} {w2:.3f} {n / w2 / 1e6:.2f} {n / w2min / 1e6:.2f}")
-' "$n" "$T/long.time" "$T/long.out" "$T/long2.time" >>"$T/decode.txt"
-  rm -f "$T/long.wav" "$T/long.json" "$T/long.out"
-done
+print(f"{sys.argv[5]} {n:.0e} {cpu:.3f} {n / cpu / 1e6:.2f} {rss:.1f} {dets} {w2:.3f} {n / w2 / 1e6:.2f} {n / w2min / 1e6:.2f}")
+' "$n" "$T/long.time" "$T/long.out" "$T/long2.time" "${f##*.}" >>"$T/decode.txt"
+  rm -f "$f" "${f%.*}.json" "$T/long.out"
+}
+for n in ${BENCH_DECODE_SAMPLES:-1e7 1e8}; do decode_bench "$n" "$T/long.wav"; done
+# an oscilloscope CSV (text, 32 bytes a row: 65 MB for the default 2 M rows)
+for n in ${BENCH_DECODE_CSV_ROWS:-2e6}; do decode_bench "$n" "$T/long.csv"; done
 # Several cores: the default scene's streams (100 repeats: 4500 streams, ~1.5 s on one core, so the one-off
 # design and calibration are a small part) on 1 and 2 threads (same output: tests/test_parallel_streams).
 for j in 1 2; do
@@ -180,13 +185,13 @@ print(f"  ratios: block kernel / sosfilt (4096) {kb/s4:.2f}, / sosfilt (1 M) {kb
       f"1 M-sample block / sosfilt (1 M) {f['BM_BandpassFixedBlock1M']/s1m:.2f}, "
       f"/ sc_fixed {kb/sc:.0f}; per-sample kernel / sc_fixed {k/sc:.0f}")
 print()
-print("Streaming decode (ranging decode --json of a WAV train, /usr/bin/time -v; MS/s per CPU second;")
-print("  --jobs 2: wall time, the median and the fastest of BENCH_DECODE_REPEATS runs; target >= 50 MS/s):")
-print(f"  {'samples':>8s} {'CPU s':>8s} {'MS/s':>8s} {'peak RSS MB':>12s} {'bursts':>7s} "
+print("Streaming decode (ranging decode --json of a train as a float32 WAV and as a CSV, /usr/bin/time -v; MS/s per")
+print("  CPU second; --jobs 2: wall time, the median and the fastest of BENCH_DECODE_REPEATS runs; target >= 50 MS/s):")
+print(f"  {'file':>4s} {'samples':>8s} {'CPU s':>8s} {'MS/s':>8s} {'peak RSS MB':>12s} {'bursts':>7s} "
       f"{'--jobs 2 wall s':>16s} {'MS/s (wall)':>12s} {'fastest run':>12s}")
 for line in open(f"{t}/decode.txt"):
-    n, cpu, rate, rss, dets, w2, r2, r2max = line.split()
-    print(f"  {n:>8s} {cpu:>8s} {rate:>8s} {rss:>12s} {dets:>7s} {w2:>16s} {r2:>12s} {r2max:>12s}")
+    kind, n, cpu, rate, rss, dets, w2, r2, r2max = line.split()
+    print(f"  {kind:>4s} {n:>8s} {cpu:>8s} {rate:>8s} {rss:>12s} {dets:>7s} {w2:>16s} {r2:>12s} {r2max:>12s}")
 print()
 w = {j: [float(v) for v in open(f"{t}/jobs{j}.time").read().split()] for j in (1, 2)}
 print("Several cores (simulate scenes/default.yaml --set geometry.repeats=100; wall time, user+sys CPU):")

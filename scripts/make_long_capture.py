@@ -4,7 +4,9 @@
 samples (its second cycle, repeated). The train is cut to a whole number of periods of eta bursts, so the tiled file keeps the
 schedule (codes 1..eta every period_s) that its metadata states.
 
-  make_long_capture.py TRAIN.wav N OUT.wav      (writes OUT.wav and OUT.json)
+  make_long_capture.py TRAIN.wav N OUT.wav [ETA]   (writes OUT.wav and OUT.json)
+  make_long_capture.py TRAIN.wav N OUT.csv [ETA]   (the same samples as an oscilloscope CSV:
+                                                    TIME,CH1 then rows '%.9e,%.9e', 32 bytes each)
 """
 import json
 import sys
@@ -40,6 +42,26 @@ def main():
     # silence) and it carries the ring-down of the previous cycle, as a steady train does.
     assert len(x) >= 2 * cycle, f"the train holds {len(x)} samples, fewer than two cycles of {eta} bursts ({cycle})"
     one = x[cycle:2 * cycle]
+    if out.endswith(".csv"):
+        write_csv(out, one, n, rate)
+    else:
+        write_wav(out, one, n, rate)
+    meta.pop("true_distance_m", None)
+    meta["code_sent"] = 0
+    json.dump(meta, open(out[:-4] + ".json", "w"), indent=2)
+
+
+def write_csv(out, one, n, rate):
+    with open(out, "w") as f:
+        f.write("TIME,CH1\n")
+        for at in range(0, n, 1 << 18):
+            k = min(n - at, 1 << 18)
+            i = np.arange(at, at + k)
+            v = one[i % len(one)].astype(np.float64)
+            f.write("".join(f"{t:.9e},{y:.9e}\n" for t, y in zip(i / rate, v)))
+
+
+def write_wav(out, one, n, rate):
     with open(out, "wb") as f:
         f.write(b"RIFF" + (36 + 4 * n).to_bytes(4, "little") + b"WAVEfmt " + (16).to_bytes(4, "little"))
         f.write((3).to_bytes(2, "little") + (1).to_bytes(2, "little") + rate.to_bytes(4, "little"))
@@ -50,9 +72,6 @@ def main():
             k = min(left, len(one))
             f.write(one[:k].astype("<f4").tobytes())
             left -= k
-    meta.pop("true_distance_m", None)
-    meta["code_sent"] = 0
-    json.dump(meta, open(out[:-4] + ".json", "w"), indent=2)
 
 
 if __name__ == "__main__":
