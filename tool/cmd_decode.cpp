@@ -170,7 +170,7 @@ int cmd_decode(const Args& args) {
   p.option("--plot", "FILE.png", "draw the capture, the bandpass output and the bank's rho^2 per code with the detections");
   add_output_options(p, {.json = true});
   p.option("--block-samples", "N", "the capture is streamed in blocks of N samples, 64..67108864 (memory and speed, not results, depend on it); auto: the capture's length / 64 rounded down to a power of two, within 65536..1048576", "auto");
-  add_jobs_option(p, "the capture's validation pass (WAV) and the bursts' metrics (Pearson rho, T_d, energy) computed");
+  add_jobs_option(p, "the capture's validation pass (a WAV's samples, a CSV's rows) and the bursts' metrics (Pearson rho, T_d, energy) computed");
   if (!p.parse(args)) return 0;
   const std::string path = p.positionals().at(0);
   if (p.has("--plot")) check_png_option("--plot", *p.get("--plot"));
@@ -183,7 +183,7 @@ int cmd_decode(const Args& args) {
   // two streamed passes: the extremes (whose larger magnitude is the decode's peak, so the
   // decode skips its own peak pass), seen as the capture is opened, then the runs at them,
   // during the receiver's pass.
-  // The open pass runs on the --jobs threads (a WAV's parts, each with its own levels).
+  // The open pass runs on the --jobs threads (a WAV's or a CSV's parts, each with its own levels).
   const int jobs = jobs_option(p);
   std::vector<FlatTopScan> part_levels(static_cast<std::size_t>(jobs));
   // The header now; the pass over the samples (a WAV's validation and the extremes) on a thread

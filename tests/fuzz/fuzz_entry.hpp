@@ -46,9 +46,40 @@ inline int scene(const std::uint8_t* data, std::size_t size) {
 }
 
 // Besides the contract: the streamed reader (CaptureSource, model/sim/capture_stream.hpp) reads
-// the same text from a file as parse_capture_csv reads it, in one part and in two (its
-// header-then-parts path): the same samples, rate and start, or the same message (its origin
-// aside). A disagreement aborts (a finding).
+// the bytes from a file as the whole-file parser reads them, in one part and in two (a CSV's
+// header-then-parts path; a WAV's samples in two runs): the same samples, rate and start, or the
+// same message (its origin aside). A disagreement aborts (a finding).
+inline void streamed_agrees(const std::string& bytes, const std::string& ext, const Capture& whole,
+                            const std::string& want) {
+  static const testing_support::ScratchDir scratch("ranging-fuzz-capture");
+  const std::string path = (scratch.path() / ("fuzz." + ext)).string();
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  for (const std::size_t parts : {std::size_t{1}, std::size_t{2}}) {
+    std::string got;
+    try {
+      std::vector<double> seen;
+      CaptureSource src(path, CaptureRead{}, [&](std::size_t, std::span<const double> x) { seen.insert(seen.end(), x.begin(), x.end()); },
+                        1);
+      std::vector<double> x(src.size() + 1);
+      x.resize(src.read(x));
+      if (x != whole.samples || seen != whole.samples || src.sample_rate() != whole.sample_rate || src.t0() != whole.t0) {
+        throw std::logic_error("CaptureSource reads other samples than the whole-file parser");
+      }
+      CaptureSource two(path, CaptureRead{}, CaptureSource::PartScan{}, parts);
+      x.assign(two.size() + 1, 0.0);
+      x.resize(two.read(x));
+      if (x != whole.samples) throw std::logic_error("CaptureSource in parts reads other samples");
+    } catch (const InputError& e) {
+      got = e.what();
+      if (got.starts_with(path)) got = "fuzz." + ext + got.substr(path.size());
+    }
+    if (got != want) throw std::logic_error("CaptureSource: '" + got + "', the whole-file parser: '" + want + "'");
+  }
+}
+
 inline int capture_csv(const std::uint8_t* data, std::size_t size) {
   const std::string text = text_of(data, size);
   Capture whole;
@@ -58,35 +89,20 @@ inline int capture_csv(const std::uint8_t* data, std::size_t size) {
   } catch (const InputError& e) {
     want = e.what();
   }
-  static const testing_support::ScratchDir scratch("ranging-fuzz-csv");
-  const std::string path = (scratch.path() / "fuzz.csv").string();
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  }
-  for (const std::size_t parts : {std::size_t{1}, std::size_t{2}}) {
-    std::string got;
-    try {
-      CaptureSource src(path, CaptureRead{}, CaptureSource::PartScan{}, parts);
-      std::vector<double> x(src.size() + 1);
-      x.resize(src.read(x));
-      if (x != whole.samples || src.sample_rate() != whole.sample_rate || src.t0() != whole.t0) {
-        throw std::logic_error("CaptureSource reads other samples than parse_capture_csv");
-      }
-    } catch (const InputError& e) {
-      got = e.what();
-      if (got.starts_with(path)) got = "fuzz.csv" + got.substr(path.size());
-    }
-    if (got != want) throw std::logic_error("CaptureSource: '" + got + "', parse_capture_csv: '" + want + "'");
-  }
+  streamed_agrees(text, "csv", whole, want);
   return 0;
 }
 
 inline int capture_wav(const std::uint8_t* data, std::size_t size) {
+  const std::string bytes = text_of(data, size);
+  Capture whole;
+  std::string want;
   try {
-    (void)parse_capture_wav(text_of(data, size), "fuzz.wav");
-  } catch (const InputError&) {
+    whole = parse_capture_wav(bytes, "fuzz.wav");
+  } catch (const InputError& e) {
+    want = e.what();
   }
+  streamed_agrees(bytes, "wav", whole, want);
   return 0;
 }
 
