@@ -18,6 +18,14 @@ namespace {
 constexpr std::size_t kWavBlockBytes = std::size_t{1} << 20;
 constexpr std::size_t kCsvScanRows = 4096;                   // rows per block of the open's scan
 constexpr std::size_t kCsvPartBytes = std::size_t{1} << 16;  // the least bytes of a CSV part
+
+// Part p's stream: part 0 reads through the source's own `in`, another part through `own`.
+std::ifstream& part_stream(std::size_t p, std::ifstream& in, std::ifstream& own, const std::string& path) {
+  if (p == 0) return in;
+  own.open(path, std::ios::binary);
+  if (!own) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
+  return own;
+}
 }  // namespace
 
 // The lines of bytes [begin, end) of a file, split as std::getline splits them: at each '\n'
@@ -219,11 +227,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   std::vector<char> bad(np, 0);
   parallel_items(np, np, [&](std::size_t p, std::size_t) {
     std::ifstream own;
-    if (p > 0) {
-      own.open(path_, std::ios::binary);
-      if (!own) throw InputError(path_ + ": cannot open the capture file: " + std::strerror(errno));
-    }
-    LineReader lr(p > 0 ? own : in_, cut[p], cut[p + 1], path_);
+    LineReader lr(part_stream(p, in_, own, path_), cut[p], cut[p + 1], path_);
     std::vector<double> block;
     if (p == 0 && scan) block.push_back(v0);
     std::string_view ln;
@@ -261,8 +265,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
     for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + part[p - 1].rows();
     parallel_items(np, np, [&](std::size_t p, std::size_t) {
       std::ifstream own;
-      if (p > 0) own.open(path_, std::ios::binary);
-      LineReader lr(p > 0 ? own : in_, cut[p], cut[p + 1], path_);
+      LineReader lr(part_stream(p, in_, own, path_), cut[p], cut[p + 1], path_);
       std::string_view ln;
       try {
         for (std::size_t n = n0[p]; lr.next(ln); ++n) rows.check_grid(n, csv_row_value(ln, 0), 0);
@@ -311,11 +314,7 @@ void CaptureSource::wav_pass(const PartScan& part_scan, std::size_t parts) {
     const std::size_t b0 = part * blocks / np, b1 = (part + 1) * blocks / np;
     if (b0 == b1) return;
     std::ifstream own;
-    if (part > 0) {
-      own.open(path_, std::ios::binary);
-      if (!own) throw InputError(path_ + ": cannot open the capture file: " + std::strerror(errno));
-    }
-    std::ifstream& in = part > 0 ? own : in_;
+    std::ifstream& in = part_stream(part, in_, own, path_);
     in.clear();
     in.seekg(static_cast<std::streamoff>(wav_.body + b0 * kScan * wav_.frame));
     std::string bytes;
