@@ -109,9 +109,10 @@ class CaptureSource {
   explicit CaptureSource(const std::string& path, const CaptureRead& how = {},
                          const std::function<void(std::span<const double>)>& scan = {});
   // The same with the scan in parts on up to `parts` threads: a WAV's samples are cut into
-  // consecutive runs of whole 65536-sample blocks, part p's run before part p + 1's, and part p
-  // sees its run in order, in the blocks the one-part scan sees (a CSV is one part). An invalid
-  // sample is reported as the one-part pass reports it: the first in the file.
+  // consecutive runs of whole 65536-sample blocks, a CSV's rows into byte ranges of whole lines
+  // (at least 64 KiB each), part p's run before part p + 1's, and part p sees its run in order,
+  // in blocks (a WAV's: those the one-part scan sees; a CSV's: up to 4096 rows). An invalid
+  // sample or row is reported as the one-part pass reports it: the first in the file.
   using PartScan = std::function<void(std::size_t part, std::span<const double>)>;
   CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& scan, std::size_t parts);
   // The same in two steps, so a caller can prepare beside the pass over the samples (decode
