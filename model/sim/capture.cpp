@@ -36,8 +36,8 @@ namespace {
 // strtod's value, end and ERANGE verdict for the number at p (C locale) within [p, end), faster
 // in the common case: std::from_chars (correctly rounded, as glibc's strtod) when it reads a
 // normal value; everything else (a leading '+' or space, hex, inf, nan, zero, subnormals,
-// overflow) goes to strtod itself: on p when *end is the string's NUL (terminated), else on a
-// NUL-terminated copy of [p, end) (a cell inside its line). (Checked against strtod on 6 M
+// overflow) goes to strtod itself, on a NUL-terminated copy of [p, end) (a cell inside its
+// line). (Checked against strtod on 6 M
 // strings: random characters, doubles in %e/%g/%f/%a/%E/%+e, the subnormal and overflow edges.)
 struct Decimal {
   double value;
@@ -81,17 +81,16 @@ bool fast_decimal(const char* p, const char* end, double& v, const char*& stop) 
   return true;
 }
 
-Decimal read_decimal(const char* p, const char* end, bool terminated) {
+Decimal read_decimal(const char* p, const char* end) {
   double v = 0;
   if (const char* stop = nullptr; fast_decimal(p, end, v, stop)) return {v, stop, false};
   const auto r = std::from_chars(p, end, v);
   if (r.ec == std::errc() && std::isnormal(v)) return {v, r.ptr, false};
-  const std::string copy = terminated ? std::string() : std::string(p, end);
-  const char* s = terminated ? p : copy.c_str();
+  const std::string copy(p, end);
   char* e = nullptr;
   errno = 0;
-  v = std::strtod(s, &e);
-  return {v, p + (e - s), errno == ERANGE};
+  v = std::strtod(copy.c_str(), &e);
+  return {v, p + (e - copy.c_str()), errno == ERANGE};
 }
 
 }  // namespace
@@ -114,7 +113,7 @@ double csv_row_value(std::string_view line, int cell) {
     }
     while (p != end && (*p == ' ' || *p == '\t' || *p == '\r' || *p == '"')) ++p;  // what trim drops
   }
-  return read_decimal(p, end, false).value;
+  return read_decimal(p, end).value;
 }
 namespace {
 
@@ -133,7 +132,7 @@ std::string_view trim(std::string_view s) {
 bool parse_number(std::string_view cell, double& out) {
   if (cell.empty()) return false;
   const char* e = cell.data() + cell.size();
-  const Decimal d = read_decimal(cell.data(), e, false);
+  const Decimal d = read_decimal(cell.data(), e);
   out = d.value;
   return d.end == e && !d.range_error;
 }

@@ -26,6 +26,26 @@ std::ifstream& part_stream(std::size_t p, std::ifstream& in, std::ifstream& own,
   if (!own) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
   return own;
 }
+
+// The open's scan of a CSV part: its rows' values handed on in blocks of kCsvScanRows.
+class BlockScan {
+ public:
+  BlockScan(const CaptureSource::PartScan& scan, std::size_t part) : scan_(scan), part_(part) {}
+  void push(double v) {
+    if (!scan_) return;
+    block_.push_back(v);
+    if (block_.size() == kCsvScanRows) flush();
+  }
+  void flush() {
+    if (scan_ && !block_.empty()) scan_(part_, block_);
+    block_.clear();
+  }
+
+ private:
+  const CaptureSource::PartScan& scan_;
+  std::size_t part_;
+  std::vector<double> block_;
+};
 }  // namespace
 
 // The lines of bytes [begin, end) of a file, split as std::getline splits them: at each '\n'
@@ -156,21 +176,16 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, co
 
 void CaptureSource::csv_pass(CsvCaptureScan& rows, const PartScan& scan) {
   LineReader lines(in_, 0, file_size_, path_);
-  std::vector<double> block;
+  BlockScan blocks(scan, 0);
   std::string_view line;
   double t = 0, v = 0;
   while (lines.next(line)) {
     if (!rows.line(line, t, v)) continue;
     if (rows.rows() == 1) data_at_ = lines.line_at();
-    if (!scan) continue;
-    block.push_back(v);
-    if (block.size() == kCsvScanRows) {
-      scan(0, block);
-      block.clear();
-    }
+    blocks.push(v);
   }
   rows.finish();
-  if (scan && !block.empty()) scan(0, block);
+  blocks.flush();
   // Every row on the uniform grid. The rows are known to be well formed now, and every line
   // from the first data row on is one (an empty line among them was refused), so only the time
   // cell is read, as read() reads a cell.
@@ -199,28 +214,12 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   const std::size_t np = std::clamp<std::size_t>((file_size_ - rest) / kCsvPartBytes, 1, parts);
   std::vector<std::size_t> cut(np + 1, file_size_);
   cut[0] = rest;
-  {
-    std::ifstream probe(path_, std::ios::binary);
-    std::string chunk;
-    for (std::size_t p = 1; p < np; ++p) {
-      std::size_t at = std::max(cut[p - 1], rest + (file_size_ - rest) / np * p);
-      // the first line start at or after `at`: past the next '\n' from at - 1 on
-      probe.clear();
-      probe.seekg(static_cast<std::streamoff>(at - 1));
-      for (bool found = false; !found && at - 1 < file_size_;) {
-        chunk.resize(std::min<std::size_t>(4096, file_size_ - (at - 1)));
-        probe.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-        const auto got = static_cast<std::size_t>(probe.gcount());
-        if (got == 0) break;
-        if (const void* nl = std::memchr(chunk.data(), '\n', got)) {
-          at += static_cast<std::size_t>(static_cast<const char*>(nl) - chunk.data());
-          found = true;
-        } else {
-          at += got;
-        }
-      }
-      cut[p] = std::min(at, file_size_);
-    }
+  for (std::size_t p = 1; p < np; ++p) {
+    // the first line start at or after `at`: the end of the line that holds byte at - 1
+    const std::size_t at = std::max(cut[p - 1], rest + (file_size_ - rest) / np * p);
+    LineReader probe(in_, at - 1, file_size_, path_);
+    (void)probe.next(line);
+    cut[p] = probe.offset();
   }
   // Each part's rows through a continuation of the scan; an error marks the part bad.
   std::vector<CsvCaptureScan> part(np, rows.continuation());
@@ -228,8 +227,8 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   parallel_items(np, np, [&](std::size_t p, std::size_t) {
     std::ifstream own;
     LineReader lr(part_stream(p, in_, own, path_), cut[p], cut[p + 1], path_);
-    std::vector<double> block;
-    if (p == 0 && scan) block.push_back(v0);
+    BlockScan blocks(scan, p);
+    if (p == 0) blocks.push(v0);
     std::string_view ln;
     double tp = 0, vp = 0;
     for (;;) {
@@ -240,14 +239,9 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
         bad[p] = 1;
         return;
       }
-      if (!scan) continue;
-      block.push_back(vp);
-      if (block.size() == kCsvScanRows) {
-        scan(p, block);
-        block.clear();
-      }
+      blocks.push(vp);
     }
-    if (scan && !block.empty()) scan(p, block);
+    blocks.flush();
   });
   // The parts' rows after the first, in order; then the file's checks and the grid, by part.
   // (Time increases across a cut too when every row is within 2 % of a step of its grid point.)
@@ -288,7 +282,6 @@ void CaptureSource::csv_done(const CsvCaptureScan& rows) {
   t0_ = rows.t0();
   n_ = rows.rows();
   meta_ = rows.meta();
-  first_data_line_ = rows.first_data_line();
   channels_ = rows.channels();
   cell_ = rows.value_cell();
   file_rate_ = rows.has_time() ? rate_ : 0;

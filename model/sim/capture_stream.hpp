@@ -146,7 +146,6 @@ class CaptureSource {
   std::size_t n_ = 0, pos_ = 0;
   CaptureMeta meta_;
   WavLayout wav_;
-  std::size_t first_data_line_ = 0;
   std::size_t file_size_ = 0, data_at_ = 0;  // CSV: bytes at open, offset of the first data row
   std::ifstream in_;
   std::unique_ptr<LineReader> lines_;  // CSV: read()'s lines, from the first data row
