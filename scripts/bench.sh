@@ -6,8 +6,9 @@
 #     one stream per AVX-512 lane);
 #   the bandpass kernel vs scipy.signal.sosfilt on the same design and input
 #     (scripts/bench_sosfilt.py) and vs SystemC sc_fixed / sc_fix (bench/bench_fixed_point);
-#   the Verilator RTL of receiver_top vs the model (tb/bench_receiver_top, then its
-#     profile-guided build tb/bench_receiver_top_pgo);
+#   the Verilator RTL of receiver_top vs the model (tb/bench_receiver_top, then its clang++
+#     builds tb/bench_receiver_top_clang and, profile-guided, tb/bench_receiver_top_pgo: which
+#     is faster depends on the CPU);
 #   streaming decode of 10 M and 100 M-sample WAV captures and a 2 M-row CSV (/usr/bin/time -v:
 #     CPU time, peak RSS; --jobs 2 wall time: median and fastest of BENCH_DECODE_REPEATS, default 5);
 #   scenes per sample: default (float, fixed, fixed without metrics) and minimal (summary.json samples_simulated),
@@ -36,10 +37,13 @@ trap 'rm -rf "$T"' EXIT
 $PY scripts/bench_sosfilt.py "$T/sos.json" >"$T/sosfilt.txt"
 if [[ -x $B/tb/bench_receiver_top ]]; then
   "$B"/tb/bench_receiver_top 2 >"$T/rtl.txt"
-  # The profile-guided build of the same bench (tb/bench.cmake; a sub-build in $B/bench-pgo,
-  # a few minutes the first time); when it cannot be built the plain figures stand alone.
+  # The clang++ and profile-guided builds of the same bench (tb/bench.cmake; a sub-build in
+  # $B/bench-pgo, a few minutes the first time); when they cannot be built the plain figures
+  # stand alone.
   if cmake --build "$B" --target bench_receiver_top_pgo >"$T/pgo.log" 2>&1; then
-    { echo; "$B"/tb/bench_receiver_top_pgo 2; } >>"$T/rtl.txt"
+    for v in clang pgo; do
+      if [[ -x $B/tb/bench_receiver_top_$v ]]; then { echo; "$B"/tb/bench_receiver_top_$v 2; } >>"$T/rtl.txt"; fi
+    done
   else
     { echo; echo "bench_receiver_top_pgo: not built (last lines of its build):"; tail -n 3 "$T/pgo.log"; } >>"$T/rtl.txt"
   fi
