@@ -102,7 +102,7 @@
 //   clearing pass. The group buffer is not cleared: its words are undefined while m_valid
 //   is low (AXI-Stream allows it).
 // Resources (yosys synth_ice40 -dsp, default parameters, standalone with every port
-//   connected, nextpnr-ice40 --up5k --pack-only): 2 SB_MAC16, 22 SB_RAM40_4K, 1811 logic
+//   connected, nextpnr-ice40 --up5k --pack-only): 2 SB_MAC16, 22 SB_RAM40_4K, 1825 logic
 //   cells (yosys 0.23). How it got there: docs/bitstream.md ("Resource history").
 //
 // Streams (AXI4-Stream rules, data stable while valid && !ready):
@@ -309,26 +309,27 @@ module correlator_bank #(
   localparam [PERIOD*FB_W-1:0] LO_NS = lo_neg_all(LO_SIN);
   localparam [CODES*WTP_W-1:0] WT_PAD = wt_pad_all(WEIGHTS);
 
-  // Constant tables read with a variable index. Each is one localparam vector holding an entry
-  // for every value of its index (a power of two of them; those past the last real entry hold
-  // the default below) at a power-of-two stride, read as a part-select at {index, zeros}: to
-  // synthesis a truth table of the index bits, to Verilator one shift (compare loops over the
-  // entries cost it one compare per entry per clock).
-  localparam integer TS_W  = wbits(TAPM_W + 1);  // tap entry stride 2^TS_W >= TAPM_W + 1
-  localparam integer WS_W  = wbits(WTP_W);       // weight entry stride 2^WS_W >= WTP_W
-  localparam integer TAP_N = 1 << TI_W;
-  localparam integer WT_N  = 1 << JI_W;
-  localparam integer CODE_N = 1 << (JI_W + CI_W);
-  function [TAP_N*(1<<TS_W)-1:0] tap_table;  // entry t: {sign of g_t, |g_t|}; past TAPS: 0
-    input [TAPS*TAP_W-1:0] v;
-    input [TAPS*TAPM_W-1:0] a;
+  // Constant tables read with a variable index.
+  // The tap ROM is a compare loop, so synthesis sees a small truth table of the index bits
+  // instead of a shifter over the whole parameter (a padded table of TAPS entries, as below,
+  // held yosys' synth_ecp5 in techmap for over 18 minutes at TAPS = 524).
+  function [TAPM_W:0] tap_rom;  // {sign of g, |g|}
+    input [TI_W-1:0] i;
     integer t;
     begin
-      tap_table = 0;
+      tap_rom = 0;
       for (t = 0; t < TAPS; t = t + 1)
-        tap_table[t*(1<<TS_W) +: TAPM_W+1] = {v[t*TAP_W + TAP_W - 1], a[t*TAPM_W +: TAPM_W]};
+        if (i == t[TI_W-1:0]) tap_rom = {TAP_VALUES[t*TAP_W + TAP_W - 1], TAP_ABS[t*TAPM_W +: TAPM_W]};
     end
   endfunction
+  // The weight and code-chip ROMs (CODES and CODES x CHIPS entries) are one localparam vector
+  // each, holding an entry for every value of the index (a power of two of them; past the last
+  // real entry the default below) at a power-of-two stride, read as a part-select at
+  // {index, zeros}: to synthesis the same truth table, to Verilator one shift where a compare
+  // loop cost it one compare per entry per clock (the chip ROM: 63 on 68 % of the clocks).
+  localparam integer WS_W  = wbits(WTP_W);  // weight entry stride 2^WS_W >= WTP_W
+  localparam integer WT_N  = 1 << JI_W;
+  localparam integer CODE_N = 1 << (JI_W + CI_W);
   function [WT_N*(1<<WS_W)-1:0] wt_table;  // entry j: w_j zero-extended to WTP_W; past CODES: 0
     input [CODES*WTP_W-1:0] v;
     integer t;
@@ -346,13 +347,8 @@ module correlator_bank #(
         for (u = 0; u < CHIPS; u = u + 1) code_table[t*(1<<CI_W) + u] = v[t*CHIPS + u];
     end
   endfunction
-  localparam [TAP_N*(1<<TS_W)-1:0] TAP_TABLE = tap_table(TAP_VALUES, TAP_ABS);
   localparam [WT_N*(1<<WS_W)-1:0] WT_TABLE = wt_table(WT_PAD);
   localparam [CODE_N-1:0] CODE_TABLE = code_table(CODE_BITS);
-  function [TAPM_W:0] tap_rom;  // {sign of g_i, |g_i|}
-    input [TI_W-1:0] i;
-    tap_rom = TAP_TABLE[{i, {TS_W{1'b0}}} +: TAPM_W+1];
-  endfunction
   function [WTP_W-1:0] wt_rom;
     input [JI_W-1:0] i;
     wt_rom = WT_TABLE[{i, {WS_W{1'b0}}} +: WTP_W];
