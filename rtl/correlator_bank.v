@@ -102,8 +102,8 @@
 //   clearing pass. The group buffer is not cleared: its words are undefined while m_valid
 //   is low (AXI-Stream allows it).
 // Resources (yosys synth_ice40 -dsp, default parameters, standalone with every port
-//   connected, nextpnr-ice40 --up5k --pack-only): 2 SB_MAC16, 22 SB_RAM40_4K, 1825 logic
-//   cells (yosys 0.23). How it got there: docs/bitstream.md ("Resource history").
+//   connected, nextpnr-ice40 --up5k --pack-only): 2 SB_MAC16, 20 SB_RAM40_4K, 1795 logic
+//   cells. How it got there: docs/bitstream.md ("Resource history").
 //
 // Streams (AXI4-Stream rules, data stable while valid && !ready):
 //   s_*: one beat per input sample (s_ready high only when the front end is idle).
@@ -309,10 +309,8 @@ module correlator_bank #(
   localparam [PERIOD*FB_W-1:0] LO_NS = lo_neg_all(LO_SIN);
   localparam [CODES*WTP_W-1:0] WT_PAD = wt_pad_all(WEIGHTS);
 
-  // Constant tables read with a variable index.
-  // The tap ROM is a compare loop, so synthesis sees a small truth table of the index bits
-  // instead of a shifter over the whole parameter (a padded table of TAPS entries, as below,
-  // held yosys' synth_ecp5 in techmap for over 18 minutes at TAPS = 524).
+  // Constant tables read with a variable index: written as compare loops so synthesis sees a
+  // small truth table of the index bits instead of a shifter over the whole parameter.
   function [TAPM_W:0] tap_rom;  // {sign of g, |g|}
     input [TI_W-1:0] i;
     integer t;
@@ -322,41 +320,24 @@ module correlator_bank #(
         if (i == t[TI_W-1:0]) tap_rom = {TAP_VALUES[t*TAP_W + TAP_W - 1], TAP_ABS[t*TAPM_W +: TAPM_W]};
     end
   endfunction
-  // The weight and code-chip ROMs (CODES and CODES x CHIPS entries) are one localparam vector
-  // each, holding an entry for every value of the index (a power of two of them; past the last
-  // real entry the default below) at a power-of-two stride, read as a part-select at
-  // {index, zeros}: to synthesis the same truth table, to Verilator one shift where a compare
-  // loop cost it one compare per entry per clock (the chip ROM: 63 on 68 % of the clocks).
-  localparam integer WS_W  = wbits(WTP_W);  // weight entry stride 2^WS_W >= WTP_W
-  localparam integer WT_N  = 1 << JI_W;
-  localparam integer CODE_N = 1 << (JI_W + CI_W);
-  function [WT_N*(1<<WS_W)-1:0] wt_table;  // entry j: w_j zero-extended to WTP_W; past CODES: 0
-    input [CODES*WTP_W-1:0] v;
-    integer t;
-    begin
-      wt_table = 0;
-      for (t = 0; t < CODES; t = t + 1) wt_table[t*(1<<WS_W) +: WTP_W] = v[t*WTP_W +: WTP_W];
-    end
-  endfunction
-  function [CODE_N-1:0] code_table;  // bit {j, m}: chip m of code j is a 1; past the codes: 1
-    input [CODES*CHIPS-1:0] v;
-    integer t, u;
-    begin
-      code_table = {CODE_N{1'b1}};
-      for (t = 0; t < CODES; t = t + 1)
-        for (u = 0; u < CHIPS; u = u + 1) code_table[t*(1<<CI_W) + u] = v[t*CHIPS + u];
-    end
-  endfunction
-  localparam [WT_N*(1<<WS_W)-1:0] WT_TABLE = wt_table(WT_PAD);
-  localparam [CODE_N-1:0] CODE_TABLE = code_table(CODE_BITS);
   function [WTP_W-1:0] wt_rom;
     input [JI_W-1:0] i;
-    wt_rom = WT_TABLE[{i, {WS_W{1'b0}}} +: WTP_W];
+    integer t;
+    begin
+      wt_rom = 0;
+      for (t = 0; t < CODES; t = t + 1) if (i == t[JI_W-1:0]) wt_rom = WT_PAD[t*WTP_W +: WTP_W];
+    end
   endfunction
   function code_rom;  // chip m of code j is a 1
     input [JI_W-1:0] j;
     input [CI_W-1:0] m;
-    code_rom = CODE_TABLE[{j, m}];
+    integer t, u;
+    begin
+      code_rom = 1'b1;
+      for (t = 0; t < CODES; t = t + 1)
+        for (u = 0; u < CHIPS; u = u + 1)
+          if (j == t[JI_W-1:0] && m == u[CI_W-1:0]) code_rom = CODE_BITS[t*CHIPS + u];
+    end
   endfunction
 
   // Quantizers q_mix / q_chip / q_corr: round half up by SHIFT, saturate to the output width
