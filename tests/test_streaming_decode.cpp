@@ -381,6 +381,8 @@ TEST(StreamingDecode, ACsvInPartsAcceptsAndRefusesAsOnePass) {
     };
     edit("bad_value", time_cell(k) + ",abc");
     edit("nan", time_cell(k) + ",nan");
+    edit("trailing_text", time_cell(k) + ",0.5x");  // a number, then more in its cell
+    edit("time_text", time_cell(k) + "s,0.5");
     edit("time_repeats", time_cell(k - 1) + ",0.5");
     char t[64];
     std::snprintf(t, sizeof t, "%.9e,0.5", (static_cast<double>(k) + 0.4) / c.sample_rate);
@@ -455,6 +457,71 @@ TEST(StreamingDecode, ACsvInPartsAcceptsAndRefusesAsOnePass) {
         got = e.what();
       }
       EXPECT_EQ(got, want) << name << " parts " << parts;
+    }
+  }
+}
+
+// The open's quick reading of plain rows (a number right after each separator) and its general
+// reading (spaces before or after, quotes, '+', '.5', tabs) mix in one file: every channel of a 3-channel CSV,
+// with ',' or ';' and '\n' or "\r\n", rows of either kind anywhere (the first one too), gives
+// strtod's value of each cell's number, through read_capture and CaptureSource in 1 to 4 parts
+// (the scan and read() alike).
+TEST(StreamingDecode, PlainAndDecoratedRowsReadAsStrtodReadsThem) {
+  const std::size_t n = 12000;  // ~0.6 MB: 4 parts
+  std::mt19937_64 rng(11);
+  for (const char sep : {',', ';'}) {
+    for (const std::string eol : {"\n", "\r\n"}) {
+      for (const int mixed : {0, 1}) {
+        std::string text = std::string("TIME") + sep + "CH1" + sep + "CH2" + sep + "CH3" + eol;
+        std::vector<std::vector<double>> want(3);
+        for (std::size_t r = 0; r < n; ++r) {
+          char t[32];
+          std::snprintf(t, sizeof t, "%.9e", static_cast<double>(r) * 2e-7);
+          std::string row = t;
+          for (int ch = 0; ch < 3; ++ch) {
+            char v[32];
+            const double x = std::uniform_real_distribution<double>(-1, 1)(rng);
+            std::snprintf(v, sizeof v, ch == 1 ? "%.17g" : "%.6e", x);
+            std::string num = v;
+            // decorated forms of the same number (general reading); kind 0 is plain
+            const int kind = mixed && (r == 0 || rng() % 5 == 0) ? static_cast<int>(1 + rng() % 6) : 0;
+            if (kind == 3 && num[0] != '-') num.insert(0, 1, '+');
+            if (kind == 4 && num.rfind("0.", 0) == 0) num.erase(0, 1);  // ".123"
+            if (kind == 4 && num.rfind("-0.", 0) == 0) num.erase(1, 1);  // "-.123"
+            want[static_cast<std::size_t>(ch)].push_back(std::strtod(num.c_str(), nullptr));
+            row += sep;
+            if (kind == 1 || kind == 2 || kind == 5) row += kind == 1 ? ' ' : kind == 2 ? '"' : '\t';
+            row += num;
+            if (kind == 1 || kind == 2 || kind == 6) row += kind == 2 ? '"' : ' ';  // 6: a trailing space alone
+          }
+          text += row + eol;
+        }
+        const std::string name = std::string("mix_") + (sep == ',' ? "comma" : "semi") + (eol.size() == 2 ? "_crlf" : "") +
+                                 (mixed ? "_mixed" : "_plain") + ".csv";
+        const std::string p = write(name, text);
+        for (int ch = 1; ch <= 3; ++ch) {
+          const std::vector<double>& w = want[static_cast<std::size_t>(ch - 1)];
+          SCOPED_TRACE(name + " channel " + std::to_string(ch));
+          const Capture whole = read_capture(p, {.channel = ch});
+          EXPECT_EQ(whole.samples, w);
+          EXPECT_EQ(whole.sample_rate, 5e6);
+          for (std::size_t parts : {1, 2, 3, 4}) {
+            SCOPED_TRACE("parts " + std::to_string(parts));
+            std::vector<std::vector<double>> seen(parts);
+            CaptureSource src(
+                p, {.channel = ch},
+                [&](std::size_t part, std::span<const double> x) { seen.at(part).insert(seen[part].end(), x.begin(), x.end()); },
+                parts);
+            std::vector<double> all;
+            for (const auto& s : seen) all.insert(all.end(), s.begin(), s.end());
+            EXPECT_EQ(all, w);
+            std::vector<double> again(n + 1);
+            EXPECT_EQ(src.read(again), n);
+            again.pop_back();
+            EXPECT_EQ(again, w);
+          }
+        }
+      }
     }
   }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -25,6 +26,25 @@ std::ifstream& part_stream(std::size_t p, std::ifstream& in, std::ifstream& own,
   own.open(path, std::ios::binary);
   if (!own) throw InputError(path + ": cannot open the capture file: " + std::strerror(errno));
   return own;
+}
+
+// The '\n' bytes in [begin, end) of the file (1 MiB at a time).
+std::size_t count_newlines(std::ifstream& in, std::size_t begin, std::size_t end, const std::string& origin) {
+  in.clear();
+  in.seekg(static_cast<std::streamoff>(begin));
+  std::vector<char> buf(std::min(kWavBlockBytes, end - begin));
+  std::size_t n = 0;
+  for (std::size_t at = begin; at < end;) {
+    const std::size_t want = std::min(buf.size(), end - at);
+    in.read(buf.data(), static_cast<std::streamsize>(want));
+    if (static_cast<std::size_t>(in.gcount()) != want) {
+      if (in.bad()) throw InputError(origin + ": cannot read the capture file");
+      throw InputError(origin + ": changed while it was read (shorter than at open)");
+    }
+    n += static_cast<std::size_t>(std::count(buf.data(), buf.data() + want, '\n'));
+    at += want;
+  }
+  return n;
 }
 
 // The open's scan of a CSV part: its rows' values handed on in blocks of kCsvScanRows.
@@ -139,12 +159,7 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, co
   const std::size_t file_size = static_cast<std::size_t>(fs::file_size(path, ec));
   if (csv_) {
     file_size_ = file_size;
-    if (parts > 1) {
-      csv_parts(how, part_scan, parts);
-    } else {
-      CsvCaptureScan rows(path, how);
-      csv_pass(rows, part_scan);
-    }
+    csv_parts(how, part_scan, parts);
   } else {
     wav_ = parse_wav_layout(
         [&](std::size_t at, std::size_t len) {
@@ -221,9 +236,49 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
     (void)probe.next(line);
     cut[p] = probe.offset();
   }
+  // The grid predicted before the pass, so each part checks its rows' times as it reads them
+  // instead of a pass of its own after finish(): in a valid file every line from the first data
+  // row on is a data row, so part p holds as many rows as it has lines (its '\n's, and the last
+  // part its unterminated last line), and the last line's time ends the span. The prediction
+  // stands only if the pass agrees: each part read that many rows and finish()'s step is the
+  // predicted one, bit for bit (then every row was checked against check_grid's own grid);
+  // otherwise (an invalid file, a last line the tail read missed) the grid pass below runs.
+  std::vector<std::size_t> lines_in(np, 0);
+  double dt_guess = 0;
+  const double t_first = t;
+  if (rows.has_time()) {
+    parallel_items(np, np, [&](std::size_t p, std::size_t) {
+      std::ifstream own;
+      lines_in[p] = count_newlines(part_stream(p, in_, own, path_), cut[p], cut[p + 1], path_);
+    });
+    std::size_t total = 1;
+    for (const std::size_t n : lines_in) total += n;
+    // the last line: the tail's bytes after its last '\n' but the final one
+    const std::size_t tail_at = std::max(rest, file_size_ - std::min<std::size_t>(file_size_, 4096));
+    std::string tail(file_size_ - tail_at, '\0');
+    in_.clear();
+    in_.seekg(static_cast<std::streamoff>(tail_at));
+    in_.read(tail.data(), static_cast<std::streamsize>(tail.size()));
+    if (static_cast<std::size_t>(in_.gcount()) == tail.size() && !tail.empty()) {
+      if (tail.back() == '\n') {
+        tail.pop_back();
+      } else {
+        ++lines_in[np - 1];
+        ++total;
+      }
+      const std::size_t nl = tail.rfind('\n');
+      if (nl != std::string::npos || tail_at == rest) {
+        const double t_last = csv_row_value(std::string_view(tail).substr(nl == std::string::npos ? 0 : nl + 1), 0);
+        if (total >= 2) dt_guess = (t_last - t_first) / static_cast<double>(total - 1);  // finish()'s step
+      }
+    }
+    if (!(std::isfinite(dt_guess) && dt_guess > 0)) dt_guess = 0;
+  }
+  std::vector<std::size_t> n0(np, 1);  // predicted row index of each part's first row
+  for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + lines_in[p - 1];
   // Each part's rows through a continuation of the scan; an error marks the part bad.
   std::vector<CsvCaptureScan> part(np, rows.continuation());
-  std::vector<char> bad(np, 0);
+  std::vector<char> bad(np, 0), off_grid(np, 0);
   parallel_items(np, np, [&](std::size_t p, std::size_t) {
     std::ifstream own;
     LineReader lr(part_stream(p, in_, own, path_), cut[p], cut[p + 1], path_);
@@ -231,7 +286,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
     if (p == 0) blocks.push(v0);
     std::string_view ln;
     double tp = 0, vp = 0;
-    for (;;) {
+    for (std::size_t n = n0[p];; ++n) {
       try {
         if (!lr.next(ln)) break;
         (void)part[p].line(ln, tp, vp);
@@ -239,6 +294,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
         bad[p] = 1;
         return;
       }
+      if (dt_guess > 0 && !CsvCaptureScan::on_grid(t_first, dt_guess, n, tp)) off_grid[p] = 1;
       blocks.push(vp);
     }
     blocks.flush();
@@ -254,9 +310,11 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
       ok = false;
     }
   }
-  if (ok && rows.has_time()) {
-    std::vector<std::size_t> n0(np, 1);  // row index of each part's first row
-    for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + part[p - 1].rows();
+  bool grid_checked = ok && dt_guess > 0 && rows.step() == dt_guess &&
+                      std::find(off_grid.begin(), off_grid.end(), 1) == off_grid.end();
+  for (std::size_t p = 0; grid_checked && p < np; ++p) grid_checked = part[p].rows() == lines_in[p];
+  if (ok && rows.has_time() && !grid_checked) {
+    for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + part[p - 1].rows();  // the rows read
     parallel_items(np, np, [&](std::size_t p, std::size_t) {
       std::ifstream own;
       LineReader lr(part_stream(p, in_, own, path_), cut[p], cut[p + 1], path_);
@@ -284,6 +342,7 @@ void CaptureSource::csv_done(const CsvCaptureScan& rows) {
   meta_ = rows.meta();
   channels_ = rows.channels();
   cell_ = rows.value_cell();
+  plain_sep_ = rows.all_rows_plain() ? rows.separator() : '\0';
   file_rate_ = rows.has_time() ? rate_ : 0;
 }
 
@@ -342,10 +401,14 @@ std::size_t CaptureSource::read(std::span<double> out) {
   std::size_t k = 0;
   if (csv_) {
     std::string_view line;
-    while (k < out.size() && pos_ < n_ && lines_->next(line)) {
-      // The rows were validated at open: the channel's cell is a finite number.
-      out[k++] = csv_row_value(line, cell_);
-      ++pos_;
+    if (plain_sep_ != '\0') {
+      for (; k < out.size() && pos_ < n_ && lines_->next(line); ++pos_) out[k++] = csv_plain_cell(line, cell_, plain_sep_);
+    } else {
+      while (k < out.size() && pos_ < n_ && lines_->next(line)) {
+        // The rows were validated at open: the channel's cell is a finite number.
+        out[k++] = csv_row_value(line, cell_);
+        ++pos_;
+      }
     }
     if (k < out.size() && pos_ < n_) throw InputError(path_ + ": changed while it was read (fewer rows than at open)");
     return k;

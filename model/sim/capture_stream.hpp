@@ -16,6 +16,7 @@
 //                   increasing time), then finish() (Record Length, row count, sample rate) and
 //                   check_grid() per row;
 //   parse_wav_layout / wav_samples the RIFF chunk walk and the samples' decoding.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
@@ -34,6 +35,9 @@ namespace ranging {
 // data row that CsvCaptureScan validated.
 char csv_separator(std::string_view line);
 double csv_row_value(std::string_view line, int cell = 1);
+// The same for a row CsvCaptureScan read the fast way (all_rows_plain()): its cells are split by
+// sep alone, and cell `cell` starts right after the cell-th separator with its number.
+double csv_plain_cell(std::string_view line, int cell, char sep);
 
 class CsvCaptureScan {
  public:
@@ -52,6 +56,15 @@ class CsvCaptureScan {
   void append(const CsvCaptureScan& part);
   void finish();  // after the last line: the file-level checks; sample_rate() and t0() valid after it
   void check_grid(std::size_t n, double t, std::size_t line) const;  // row n (0-based) at `line`
+  // check_grid's test: row n's time t within 2 % of a step of the grid t0 + n dt
+  static bool on_grid(double t0, double dt, std::size_t n, double t) {
+    return !(std::abs(t - (t0 + dt * static_cast<double>(n))) > 0.02 * dt);
+  }
+  double step() const { return dt_; }  // the grid's step, after finish()
+  // Every data row after the first was read the fast way (fast_row): each is split by
+  // separator() alone and its cells start with their numbers (csv_plain_cell reads them).
+  bool all_rows_plain() const { return sep_ != '\0' && first_plain_ && rows_ > 0 && fast_rows_ == rows_ - 1; }
+  char separator() const { return sep_; }
   std::size_t lineno() const { return lineno_; }
   std::size_t first_data_line() const { return first_data_line_; }
   std::size_t rows() const { return rows_; }
@@ -68,10 +81,19 @@ class CsvCaptureScan {
   double given_rate_ = 0;
   bool no_time_ = false;
   CaptureMeta meta_;
+  std::size_t fast_rows_ = 0;  // the rows fast_row read
   std::size_t lineno_ = 0, rows_ = 0, first_data_line_ = 0, last_data_line_ = 0, record_line_ = 0;
   bool data_ = false;
   double record_length_ = -1, t_first_ = 0, t_last_ = 0, dt_ = 0;
   std::vector<std::string_view> cells_;  // line()'s cells of the current line (views into it)
+  char sep_ = '\0';  // the first data row's separator (',' or ';'; '\0': whitespace, or samples alone)
+  // A data row after the first in the common form, read without splitting the line: the
+  // separator sep_ alone, every cell read a plain number starting with '-' or a digit, no
+  // spaces or quotes around them, at most one '\r' at the end. True: the row was read (as the
+  // general way reads it, to the same values); false: nothing changed, the general way reads it.
+  bool fast_row(std::string_view text, double& t, double& v);
+  bool plain_cells(std::string_view text, double& t, double& v) const;  // fast_row's reading of the cells
+  bool first_plain_ = false;  // the first data row is one plain_cells reads
 };
 
 struct WavLayout {
@@ -142,6 +164,7 @@ class CaptureSource {
   std::string path_;
   bool csv_ = false;
   int channels_ = 1, cell_ = 1;
+  char plain_sep_ = '\0';  // CSV: every data row plain (CsvCaptureScan::all_rows_plain): its separator
   double rate_ = 0, t0_ = 0, file_rate_ = 0;
   std::size_t n_ = 0, pos_ = 0;
   CaptureMeta meta_;
