@@ -642,7 +642,8 @@ TEST(Capture, CsvNumbersAreReadExactlyAsStrtodReadsThem) {
   const std::vector<std::string> cells = {
       "1.234567890e-03", "+1.5e-3", "-0.000000000e+00", "0", ".5", "1.", "1.e5", "-.5E-3", "0x1p-3",
       "1e-310", "4.9e-324", "2.2250738585072014e-308", "1.7976931348623157e308", "1e309", "9007199254740993",
-      "1.00000000000000011102230246251565404236316680908203125", "1e", "1e+", "12abc", "0x", "infinity", "-nan"};
+      "1.00000000000000011102230246251565404236316680908203125", "1e", "1e+", "12abc", "0x", "infinity", "-nan",
+      "-0", "000.000", "-0e-400", "0.0e+999", "-0.00000000000000000000000", "0e", "-0x1p+2", "00x5", "0.0x1"};
   const testing_support::ScratchDir scratch("capture_num", ::testing::TempDir());
   for (const auto& s : cells) {
     SCOPED_TRACE(s);

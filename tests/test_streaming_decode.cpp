@@ -402,13 +402,14 @@ TEST(StreamingDecode, ACsvInPartsAcceptsAndRefusesAsOnePass) {
       want = e.what();
     }
     refused += !want.empty();
-    for (std::size_t parts : {1, 2, 3, 4}) {
-      SCOPED_TRACE(name + ", parts " + std::to_string(parts));
+    for (std::size_t parts : {1, 2, 3, 4})
+    for (std::size_t keep : {std::size_t{0}, CaptureRead{}.csv_keep_rows}) {
+      SCOPED_TRACE(name + ", parts " + std::to_string(parts) + ", keep " + std::to_string(keep));
       std::vector<std::vector<double>> seen(parts);
       std::string got;
       try {
         CaptureSource src(
-            p, {}, [&](std::size_t part, std::span<const double> x) { seen.at(part).insert(seen[part].end(), x.begin(), x.end()); },
+            p, {.csv_keep_rows = keep}, [&](std::size_t part, std::span<const double> x) { seen.at(part).insert(seen[part].end(), x.begin(), x.end()); },
             parts);
         std::vector<double> all;
         for (const auto& s : seen) all.insert(all.end(), s.begin(), s.end());
@@ -465,7 +466,7 @@ TEST(StreamingDecode, ACsvInPartsAcceptsAndRefusesAsOnePass) {
 // reading (spaces before or after, quotes, '+', '.5', tabs) mix in one file: every channel of a 3-channel CSV,
 // with ',' or ';' and '\n' or "\r\n", rows of either kind anywhere (the first one too), gives
 // strtod's value of each cell's number, through read_capture and CaptureSource in 1 to 4 parts
-// (the scan and read() alike).
+// (the scan and read() alike, read() from the values the open kept or from the file again).
 TEST(StreamingDecode, PlainAndDecoratedRowsReadAsStrtodReadsThem) {
   const std::size_t n = 12000;  // ~0.6 MB: 4 parts
   std::mt19937_64 rng(11);
@@ -505,11 +506,12 @@ TEST(StreamingDecode, PlainAndDecoratedRowsReadAsStrtodReadsThem) {
           const Capture whole = read_capture(p, {.channel = ch});
           EXPECT_EQ(whole.samples, w);
           EXPECT_EQ(whole.sample_rate, 5e6);
-          for (std::size_t parts : {1, 2, 3, 4}) {
-            SCOPED_TRACE("parts " + std::to_string(parts));
+          for (std::size_t parts : {1, 2, 3, 4})
+          for (std::size_t keep : {std::size_t{0}, n, CaptureRead{}.csv_keep_rows}) {  // read() parses or serves
+            SCOPED_TRACE("parts " + std::to_string(parts) + ", keep " + std::to_string(keep));
             std::vector<std::vector<double>> seen(parts);
             CaptureSource src(
-                p, {.channel = ch},
+                p, {.channel = ch, .csv_keep_rows = keep},
                 [&](std::size_t part, std::span<const double> x) { seen.at(part).insert(seen[part].end(), x.begin(), x.end()); },
                 parts);
             std::vector<double> all;
@@ -519,6 +521,10 @@ TEST(StreamingDecode, PlainAndDecoratedRowsReadAsStrtodReadsThem) {
             EXPECT_EQ(src.read(again), n);
             again.pop_back();
             EXPECT_EQ(again, w);
+            src.rewind();  // and again, in blocks
+            std::vector<double> blocks, block(1000);
+            for (std::size_t k; (k = src.read(block)) > 0;) blocks.insert(blocks.end(), block.begin(), block.begin() + static_cast<long>(k));
+            EXPECT_EQ(blocks, w);
           }
         }
       }

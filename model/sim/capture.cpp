@@ -47,7 +47,8 @@ struct Decimal {
 // Clinger's fast path first: [-]D+[.D+][(e|E)[+|-]D{1,3}] with at most 19 digits whose integer
 // m is at most 2^53, scaled by 10^k, |k| <= 22. m and 10^|k| are exact doubles, so one IEEE
 // multiply or divide rounds the exact value m 10^k once, to nearest: strtod's correctly rounded
-// value. A scope's %.9e cells all take it; anything else, or m == 0, goes on to from_chars.
+// value. A scope's %.9e cells all take it (zeros too: m == 0 is +-0 exactly); anything else
+// goes on to from_chars.
 // The 8 characters at q as a number when all are digits (SWAR: one 64-bit load, three
 // multiplies; little-endian hosts, else false and the caller's loop reads them one by one).
 inline bool eight_digits(const char* q, std::uint64_t& v) {
@@ -84,7 +85,8 @@ bool fast_decimal(const char* p, const char* end, double& v, const char*& stop) 
     for (; end - q >= 8 && eight_digits(q, m8); q += 8, digits += 8, k -= 8) m = 100000000 * m + m8;
     for (; digit(q); ++q, ++digits, --k) m = 10 * m + static_cast<unsigned>(*q - '0');
   }
-  if (digits > 19 || m == 0 || m > (std::uint64_t{1} << 53)) return false;
+  if (digits > 19 || m > (std::uint64_t{1} << 53)) return false;
+  if (m == 0 && q != end && (*q == 'x' || *q == 'X')) return false;  // "0x...": strtod reads hex
   if (q != end && (*q == 'e' || *q == 'E')) {
     const char* x = q + 1;
     const bool xneg = x != end && *x == '-';
@@ -96,7 +98,7 @@ bool fast_decimal(const char* p, const char* end, double& v, const char*& stop) 
     q = x;
   }
   if (k < -22 || k > 22) return false;
-  const double a = static_cast<double>(m);
+  const double a = static_cast<double>(m);  // m == 0: +0 or -0 whatever k, as strtod reads it
   v = k < 0 ? a / kPow10[-k] : a * kPow10[k];
   if (neg) v = -v;
   stop = q;
@@ -350,7 +352,7 @@ bool CsvCaptureScan::fast_row(std::string_view text, double& t, double& v) {
 
 bool CsvCaptureScan::line(std::string_view text, double& t, double& v) {
   ++lineno_;
-  if (sep_ != '\0' && fast_row(text, t, v)) return true;
+  if (sep_ != '\0' && fast_ && fast_row(text, t, v)) return true;
   if (trim(text).empty()) {
     if (data_) fail_at(origin_, lineno_, "empty line inside the data rows");
     return false;

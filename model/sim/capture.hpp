@@ -29,6 +29,7 @@
 // read_capture() takes the CSV header lines, then fills what they lack from the sidecar (a
 // WAV's only source). A value that is malformed or out of range is an InputError naming the
 // file, the line or key and the valid range.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -64,6 +65,10 @@ struct Capture {
 struct CaptureRead {
   int channel = 1;
   double sample_rate = 0;
+  // CaptureSource: a CSV of at most this many rows keeps the values its open pass read (8 bytes
+  // a row: 64 MiB at the default), and read() serves them instead of parsing the rows again;
+  // a longer one is read again from the file (memory stays bounded). 0: never kept.
+  std::size_t csv_keep_rows = std::size_t{1} << 23;
 };
 
 // The sidecar JSON's text for meta, and its parse (InputError naming origin and the key).

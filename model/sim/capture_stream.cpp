@@ -246,13 +246,13 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   std::vector<std::size_t> lines_in(np, 0);
   double dt_guess = 0;
   const double t_first = t;
-  if (rows.has_time()) {
-    parallel_items(np, np, [&](std::size_t p, std::size_t) {
-      std::ifstream own;
-      lines_in[p] = count_newlines(part_stream(p, in_, own, path_), cut[p], cut[p + 1], path_);
-    });
-    std::size_t total = 1;
-    for (const std::size_t n : lines_in) total += n;
+  parallel_items(np, np, [&](std::size_t p, std::size_t) {
+    std::ifstream own;
+    lines_in[p] = count_newlines(part_stream(p, in_, own, path_), cut[p], cut[p + 1], path_);
+  });
+  std::size_t total = 1;  // the predicted rows
+  for (const std::size_t n : lines_in) total += n;
+  {
     // the last line: the tail's bytes after its last '\n' but the final one
     const std::size_t tail_at = std::max(rest, file_size_ - std::min<std::size_t>(file_size_, 4096));
     std::string tail(file_size_ - tail_at, '\0');
@@ -267,7 +267,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
         ++total;
       }
       const std::size_t nl = tail.rfind('\n');
-      if (nl != std::string::npos || tail_at == rest) {
+      if (rows.has_time() && (nl != std::string::npos || tail_at == rest)) {
         const double t_last = csv_row_value(std::string_view(tail).substr(nl == std::string::npos ? 0 : nl + 1), 0);
         if (total >= 2) dt_guess = (t_last - t_first) / static_cast<double>(total - 1);  // finish()'s step
       }
@@ -276,6 +276,13 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   }
   std::vector<std::size_t> n0(np, 1);  // predicted row index of each part's first row
   for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + lines_in[p - 1];
+  // A file of at most how.csv_keep_rows rows keeps the pass's values for read() (kept_[n]: row
+  // n's), if the prediction holds (each part read as many rows as it has lines).
+  kept_.reset();
+  if (total <= how.csv_keep_rows) {
+    kept_ = std::make_unique_for_overwrite<double[]>(total);
+    kept_[0] = v0;
+  }
   // Each part's rows through a continuation of the scan; an error marks the part bad.
   std::vector<CsvCaptureScan> part(np, rows.continuation());
   std::vector<char> bad(np, 0), off_grid(np, 0);
@@ -295,6 +302,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
         return;
       }
       if (dt_guess > 0 && !CsvCaptureScan::on_grid(t_first, dt_guess, n, tp)) off_grid[p] = 1;
+      if (kept_ && n < total) kept_[n] = vp;
       blocks.push(vp);
     }
     blocks.flush();
@@ -310,9 +318,11 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
       ok = false;
     }
   }
-  bool grid_checked = ok && dt_guess > 0 && rows.step() == dt_guess &&
-                      std::find(off_grid.begin(), off_grid.end(), 1) == off_grid.end();
-  for (std::size_t p = 0; grid_checked && p < np; ++p) grid_checked = part[p].rows() == lines_in[p];
+  bool as_predicted = ok && rows.rows() == total;  // every part read as many rows as it has lines
+  for (std::size_t p = 0; as_predicted && p < np; ++p) as_predicted = part[p].rows() == lines_in[p];
+  if (!as_predicted) kept_.reset();
+  const bool grid_checked = as_predicted && dt_guess > 0 && rows.step() == dt_guess &&
+                            std::find(off_grid.begin(), off_grid.end(), 1) == off_grid.end();
   if (ok && rows.has_time() && !grid_checked) {
     for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + part[p - 1].rows();  // the rows read
     parallel_items(np, np, [&](std::size_t p, std::size_t) {
@@ -390,7 +400,7 @@ void CaptureSource::seek_start() {
   in_.clear();
   pos_ = 0;
   if (csv_) {
-    lines_ = std::make_unique<LineReader>(in_, data_at_, file_size_, path_);
+    if (!kept_) lines_ = std::make_unique<LineReader>(in_, data_at_, file_size_, path_);
   } else {
     in_.seekg(static_cast<std::streamoff>(wav_.body));
   }
@@ -399,6 +409,12 @@ void CaptureSource::seek_start() {
 std::size_t CaptureSource::read(std::span<double> out) {
   if (!finished_) throw std::logic_error("CaptureSource: read() before finish()");
   std::size_t k = 0;
+  if (csv_ && kept_) {
+    const std::size_t want = std::min(out.size(), n_ - pos_);
+    std::copy_n(kept_.get() + pos_, want, out.data());
+    pos_ += want;
+    return want;
+  }
   if (csv_) {
     std::string_view line;
     if (plain_sep_ != '\0') {

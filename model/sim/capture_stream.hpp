@@ -65,6 +65,9 @@ class CsvCaptureScan {
   // separator() alone and its cells start with their numbers (csv_plain_cell reads them).
   bool all_rows_plain() const { return sep_ != '\0' && first_plain_ && rows_ > 0 && fast_rows_ == rows_ - 1; }
   char separator() const { return sep_; }
+  // false: every row goes the general way (split_cells), none the fast way; a reference reading
+  // for the tests and the fuzz target, which compare the two.
+  void set_fast_rows(bool on) { fast_ = on; }
   std::size_t lineno() const { return lineno_; }
   std::size_t first_data_line() const { return first_data_line_; }
   std::size_t rows() const { return rows_; }
@@ -94,6 +97,7 @@ class CsvCaptureScan {
   bool fast_row(std::string_view text, double& t, double& v);
   bool plain_cells(std::string_view text, double& t, double& v) const;  // fast_row's reading of the cells
   bool first_plain_ = false;  // the first data row is one plain_cells reads
+  bool fast_ = true;          // set_fast_rows
 };
 
 struct WavLayout {
@@ -172,6 +176,9 @@ class CaptureSource {
   std::size_t file_size_ = 0, data_at_ = 0;  // CSV: bytes at open, offset of the first data row
   std::ifstream in_;
   std::unique_ptr<LineReader> lines_;  // CSV: read()'s lines, from the first data row
+  // A CSV of at most CaptureRead::csv_keep_rows rows: the open pass's values, which read()
+  // then serves instead of reading and parsing the rows again (null: read() parses the rows).
+  std::unique_ptr<double[]> kept_;
   std::string buf_;
   PartScan pending_scan_;            // Deferred: finish()'s scan
   std::size_t pending_parts_ = 1;

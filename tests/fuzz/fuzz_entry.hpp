@@ -57,12 +57,13 @@ inline void streamed_agrees(const std::string& bytes, const std::string& ext, co
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   }
-  for (const std::size_t parts : {std::size_t{1}, std::size_t{2}}) {
+  for (const std::size_t parts : {std::size_t{1}, std::size_t{2}})
+  for (const std::size_t keep : {std::size_t{0}, CaptureRead{}.csv_keep_rows}) {  // read() parses again, or not
     std::string got;
     try {
       std::vector<std::vector<double>> part(parts);  // the open's scan, part by part (a thread each)
       CaptureSource src(
-          path, CaptureRead{}, [&](std::size_t k, std::span<const double> x) { part[k].insert(part[k].end(), x.begin(), x.end()); },
+          path, CaptureRead{.csv_keep_rows = keep}, [&](std::size_t k, std::span<const double> x) { part[k].insert(part[k].end(), x.begin(), x.end()); },
           parts);
       std::vector<double> seen;
       for (const auto& s : part) seen.insert(seen.end(), s.begin(), s.end());
@@ -79,6 +80,35 @@ inline void streamed_agrees(const std::string& bytes, const std::string& ext, co
   }
 }
 
+// The rows of text read the general way only (CsvCaptureScan::set_fast_rows(false)), as
+// parse_capture_csv reads them otherwise: the samples, or the message.
+inline std::vector<double> csv_general_way(const std::string& text, std::string& error) {
+  std::vector<double> t, v;
+  try {
+    CsvCaptureScan scan("fuzz.csv", {});
+    scan.set_fast_rows(false);
+    std::vector<std::size_t> lines;
+    std::size_t b = 0;
+    double tv = 0, vv = 0;
+    while (b < text.size()) {  // std::getline's lines
+      const std::size_t e = std::min(text.find('\n', b), text.size());
+      if (scan.line(std::string_view(text).substr(b, e - b), tv, vv)) {
+        t.push_back(tv);
+        v.push_back(vv);
+        lines.push_back(scan.lineno());
+      }
+      b = e + 1;
+    }
+    scan.finish();
+    for (std::size_t n = 0; n < t.size(); ++n) scan.check_grid(n, t[n], lines[n]);
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  return v;
+}
+
+// Besides the contract: the fast reading of plain rows agrees with the general way (the same
+// samples or the same message), and the streamed reader with the whole-file parser.
 inline int capture_csv(const std::uint8_t* data, std::size_t size) {
   const std::string text = text_of(data, size);
   Capture whole;
@@ -87,6 +117,11 @@ inline int capture_csv(const std::uint8_t* data, std::size_t size) {
     whole = parse_capture_csv(text, "fuzz.csv");
   } catch (const InputError& e) {
     want = e.what();
+  }
+  std::string general_error;
+  const std::vector<double> general = csv_general_way(text, general_error);
+  if (general_error != want || (want.empty() && general != whole.samples)) {
+    throw std::logic_error("the fast rows: '" + want + "', the general way: '" + general_error + "'");
   }
   streamed_agrees(text, "csv", whole, want);
   return 0;
