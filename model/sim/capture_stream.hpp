@@ -2,15 +2,19 @@
 // Reading a capture (model/sim/capture.hpp: oscilloscope CSV or WAV) in blocks, for captures
 // longer than memory: CaptureSource validates the whole file when it is opened (the same checks
 // and the same error messages as read_capture, in the same order), then read() delivers the
-// samples in order, a block at a time, as often as rewind() starts over. Memory is one block.
+// samples in order, a block at a time, as often as rewind() starts over. Memory is bounded:
+// a block, and a CSV's values up to CaptureRead::csv_keep_rows rows (64 MiB by default).
 //   WAV: the header is parsed from the file (parse_wav_layout); the samples are read from the
 //        data chunk in blocks (one pass to check them for NaN/Inf at open for float WAVs).
-//   CSV: open() reads the file once for the header, the rows' syntax and the time grid's span
-//        (CsvCaptureScan), a second time for the uniform-grid check (every row within 2 % of a
-//        step); read() parses the rows again. Lines come through one 1 MiB buffer (LineReader).
-//        With parts > 1 both passes run on threads over byte ranges of whole lines after the
-//        first data row (at least 64 KiB each); an error in any part sends the file through the
-//        one-thread pass, which names the first error and its line as read_capture does.
+//   CSV: open() reads the header up to the first data row, counts the lines after it and reads
+//        the last one's time, which predict the row count and the grid's step; then one pass
+//        over the rows (CsvCaptureScan: syntax, increasing time, each row on the predicted grid)
+//        on up to `parts` threads, each a byte range of whole lines (at least 64 KiB). Only if
+//        the prediction does not hold does a second pass check the grid (every row within 2 %
+//        of a step). read() serves the values the pass kept (a file of at most csv_keep_rows
+//        rows) or parses the rows again. Lines come through one 1 MiB buffer (LineReader). An
+//        error in any part sends the file through the one-thread pass, which names the first
+//        error and its line as read_capture does.
 // The pieces read_capture shares with it (one implementation of every check):
 //   CsvCaptureScan  the CSV line grammar, row by row (header lines, metadata keys, strict numbers,
 //                   increasing time), then finish() (Record Length, row count, sample rate) and
