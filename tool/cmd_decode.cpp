@@ -29,56 +29,11 @@
 #include "tool/guard.hpp"
 #include "tool/commands.hpp"
 #include "tool/json_meta.hpp"
+#include "tool/json_text.hpp"
 #include "tool/options.hpp"
 #include "tool/plot.hpp"
 
 namespace ranging::tool {
-
-namespace {
-// The text nlohmann's dump(2) writes for an array of to_json(v[i]) whose key sits at `depth`
-// (1: a key of the top-level object), each element dumped on its own on up to `jobs` threads
-// and indented into place: the same bytes as the array in the document.
-template <class T, class F>
-std::string json_array_text(const std::vector<T>& v, const F& to_json, int depth, int jobs) {
-  if (v.empty()) return "[]";
-  const std::string pad(static_cast<std::size_t>(2 * (depth + 1)), ' ');
-  std::vector<std::string> parts(v.size());
-  constexpr std::size_t kChunk = 512;
-  const std::size_t chunks = (v.size() + kChunk - 1) / kChunk;
-  parallel_items(chunks, std::min<std::size_t>(static_cast<std::size_t>(std::max(jobs, 1)), chunks),
-                 [&](std::size_t c, std::size_t) {
-                   for (std::size_t i = c * kChunk; i < std::min(v.size(), (c + 1) * kChunk); ++i) {
-                     const std::string e = to_json(v[i]).dump(2);
-                     std::string& out = parts[i];
-                     out.reserve(e.size() + 64);
-                     out += pad;
-                     for (std::size_t a = 0, b; a < e.size(); a = b + 1) {  // line by line
-                       b = e.find('\n', a);
-                       if (b == std::string::npos) {
-                         out.append(e, a, std::string::npos);
-                         break;
-                       }
-                       out.append(e, a, b + 1 - a);
-                       out += pad;
-                     }
-                   }
-                 });
-  std::size_t total = 0;
-  for (const auto& p : parts) total += p.size() + 2;
-  std::string out;
-  out.reserve(total + 16);
-  out += "[\n";
-  for (std::size_t i = 0; i < parts.size(); ++i) {
-    if (i) out += ",\n";
-    out += parts[i];
-  }
-  out += "\n";
-  out.append(static_cast<std::size_t>(2 * depth), ' ');
-  out += "]";
-  return out;
-}
-}  // namespace
-
 
 namespace {
 
@@ -169,7 +124,7 @@ int cmd_decode(const Args& args) {
   p.option("--distance", "M", "the distance of the --calibrate capture, 0.001..1000 m");
   p.option("--plot", "FILE.png", "draw the capture, the bandpass output and the bank's rho^2 per code with the detections");
   add_output_options(p, {.json = true});
-  p.option("--block-samples", "N", "the capture is streamed in blocks of N samples, 64..67108864 (memory and speed, not results, depend on it); auto: the capture's length / 64 rounded down to a power of two, within 65536..1048576", "auto");
+  p.option("--block-samples", "N", "the capture is streamed in blocks of up to N samples, 64..67108864 (the first of 16384 at most, each next twice the last; memory and speed, not results, depend on it); auto: the capture's length / 64 rounded down to a power of two, within 65536..1048576", "auto");
   add_jobs_option(p, "the capture's validation pass (a WAV's samples, a CSV's rows) and the bursts' metrics (Pearson rho, T_d, energy) computed");
   if (!p.parse(args)) return 0;
   const std::string path = p.positionals().at(0);
@@ -383,17 +338,22 @@ int decode_opened(cli::Parser& p, const std::string& path, const CaptureRead& ho
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
   auto tof_of = [&](const Detection& d) { return d.tof_from_send ? d.tof_s : nan; };
-  auto det_json = [&](const Detection& d) {
+  // One detection's members, in key order (tool/json_text.hpp: dump()'s text without a json
+  // object per detection).
+  auto det_text = [&](JsonObjectText& o, const Detection& d) {
     const double tof = tof_of(d);
-    nlohmann::json o = {{"code", d.code}, {"tof_s", tof}, {"distance_m", tof * c.value},
-                        {"rho", d.rho_max}, {"pearson_margin", d.pearson_margin}, {"pearson_code", d.pearson_code},
-                        {"receiver_rho2", d.score}};
+    if (!d.tof_from_send) o.number("arrival_s", d.arrival_s);
+    o.integer("code", d.code);
+    o.number("distance_m", tof * c.value);
+    if (meta.true_distance_m) o.number("error_m", tof * c.value - *meta.true_distance_m);
+    o.integer("pearson_code", d.pearson_code);
+    o.number("pearson_margin", d.pearson_margin);
+    o.number("receiver_rho2", d.score);
+    o.number("rho", d.rho_max);
+    o.number("tof_s", tof);
     if (known && d.rho.size() >= 2 && *meta.code_sent <= static_cast<int>(d.rho.size())) {
-      o["u"] = u_for_sent(d.rho, *meta.code_sent);  // eq. 10, with the code the metadata says was sent
+      o.number("u", u_for_sent(d.rho, *meta.code_sent));  // eq. 10, with the code the metadata says was sent
     }
-    if (meta.true_distance_m) o["error_m"] = tof * c.value - *meta.true_distance_m;
-    if (!d.tof_from_send) o["arrival_s"] = d.arrival_s;
-    return o;
   };
 
   if (p.has("--json")) {
@@ -418,20 +378,22 @@ int decode_opened(cli::Parser& p, const std::string& path, const CaptureRead& ho
     if (meta.scene) j["scene"] = *meta.scene;
     if (meta.code_sent) j["code_sent"] = *meta.code_sent;
     if (meta.true_distance_m) j["true_distance_m"] = *meta.true_distance_m;
-    // The detections (50 000 in a 100 M-sample capture) are written on sim.jobs() threads, each
-    // element as dump(2) places it in the document; the document holds a marker in their place.
-    const std::string det_mark = "\\u0001detections\\u0001";  // as dump() escapes the marker
-    j["detections"] = "\x01" "detections" "\x01";
-    j["below_gate"] = nlohmann::json::array();
-    for (const auto& d : below) j["below_gate"].push_back(det_json(d));
+    // The detections (50 000 in a 100 M-sample capture) are written on sim.jobs() threads as
+    // dump(2) places them in the document, which holds a marker string in their place.
+    const std::pair<const char*, const std::vector<Detection>*> lists[] = {{"detections", &dets},
+                                                                           {"below_gate", &below}};
+    for (const auto& [key, list] : lists) j[key] = std::string("\x01") + key + "\x01";
     j["found"] = !dets.empty();
     j["arrivals_before_first_send"] = unsent;  // their tof_s and distance_m are null
     j["input_clipping"] = {{"samples", clip.samples}, {"runs", clip.runs}, {"max", clip.high}, {"min", clip.low},
                            {"rule", "runs of >= 3 consecutive samples at the capture's maximum or minimum"}};
     std::string text = stamp_build_info(j).dump(2);
-    const std::size_t at = text.find("\"" + det_mark + "\"");
-    if (at == std::string::npos) throw std::logic_error("decode --json: the detections' marker is missing");
-    text.replace(at, det_mark.size() + 2, json_array_text(dets, det_json, 1, sim.jobs()));
+    for (const auto& [key, list] : lists) {
+      const std::string mark = std::string("\"\\u0001") + key + "\\u0001\"";  // as dump() escapes it
+      const std::size_t at = text.find(mark);
+      if (at == std::string::npos) throw std::logic_error(std::string("decode --json: the marker of ") + key + " is missing");
+      text.replace(at, mark.size(), json_array_text(*list, det_text, 1, sim.jobs()));
+    }
     std::cout << text << "\n";
   } else {
     std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s%s%s\n",
