@@ -157,11 +157,18 @@ TEST(StreamingDecode, ThreadsAndTheSecondPassGiveTheSameDetections) {
         for (std::size_t block : {std::size_t{64}, std::size_t{997}, std::size_t{1} << 20}) {
           SCOPED_TRACE(precision + ", lookback " + (lookback ? std::to_string(*lookback) : "derived") + ", jobs " +
                        std::to_string(jobs) + ", block " + std::to_string(block));
-          std::size_t blocks = 0;
-          expect_same(ref, sim.decode_stream("Gold4", src, 0.002, block, {}, [&](std::span<const double>) { ++blocks; }));
-          EXPECT_EQ(blocks, (whole.samples.size() + block - 1) / block) << "the scan sees each block once";
+          // the blocks: min(block, kDecodeFirstBlock), then each twice the last up to `block`
+          std::vector<std::size_t> sizes, expected;
+          for (std::size_t left = whole.samples.size(), b = std::min(block, SceneSimulator::kDecodeFirstBlock); left > 0;
+               b = std::min(block, 2 * b)) {
+            expected.push_back(std::min(b, left));
+            left -= expected.back();
+          }
+          expect_same(ref, sim.decode_stream("Gold4", src, 0.002, block, {},
+                                             [&](std::span<const double> x) { sizes.push_back(x.size()); }));
+          EXPECT_EQ(sizes, expected) << "the scan sees each block once";
           // one block holds every event before any burst settles: nothing to break then
-          EXPECT_EQ(sim.decode_passes(), lookback && block < whole.samples.size() ? 2 : 1);
+          EXPECT_EQ(sim.decode_passes(), lookback && expected.size() > 1 ? 2 : 1);
         }
       }
     }

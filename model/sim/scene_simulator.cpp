@@ -1238,9 +1238,12 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       return lk.metrics_window(pend[i].d, wr, base, n, pend[i].start, pend[i].end, pb);
     };
     // Blocks are read one ahead (item 1 of a round reads the next while item 0 receives this one).
+    // The first block is short and each next one twice the last, up to `block`: the first
+    // round's receiver runs alone (no burst is ready before it), so it is kept short.
     std::vector<double> xn(block);
     src.rewind();
-    std::size_t k = src.read(x);
+    std::size_t want = std::min(block, kDecodeFirstBlock);
+    std::size_t k = src.read(std::span<double>(x.data(), want));
     for (bool last = false; !last;) {
       last = k == 0;
       const std::size_t w0 = wn;
@@ -1257,6 +1260,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       const std::span<double> fk = metrics ? std::span<double>(w.data() + w0, k) : std::span<double>();
       const std::span<double> xk(x.data(), k);
       std::size_t k_next = 0;
+      const std::size_t want_next = std::min(block, 2 * want);
       // item 0: the receiver on this block (the pending candidate after the last); item 1: the
       // next block's read; item 2 at fixed precision: the metrics' float filter; then the ready
       // bursts' metrics
@@ -1270,13 +1274,14 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
                          return rcv.block(xk, got, fixed ? std::span<double>() : fk);
                        }
                        if (item == 1 && !last) {
-                         k_next = src.read(xn);
+                         k_next = src.read(std::span<double>(xn.data(), want_next));
                          return;
                        }
                        if (item == 2 && first == 3) return bp.execute_block(xk, fk);
                        done[item - first] = metrics_of(ready[item - first], wr, t);
                      });
       x.swap(xn);
+      want = want_next;
       // ready is a subsequence of active, in order: one pass drops the finished ones
       std::size_t r = 0;
       std::erase_if(active, [&](std::size_t i) { return r < ready.size() && ready[r] == i && done[r++]; });

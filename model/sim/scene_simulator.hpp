@@ -191,7 +191,9 @@ class SceneSimulator {
   std::vector<Detection> decode(const std::string& family, const std::vector<double>& x, double t0,
                                 double period_s = 0);
 
-  // decode() of a capture read in blocks of `block` samples: the same detections, bit for bit,
+  // decode() of a capture read in blocks of up to `block` samples (the first of
+  // min(block, kDecodeFirstBlock), each next twice the last until `block`: the first block's
+  // receiver runs alone, no burst being ready before it): the same detections, bit for bit,
   // in memory independent of the capture's length. Two passes: the capture's peak, then the
   // receiver with the bursts' metrics beside it over a sliding window of the filtered stream
   // (it spans the bursts whose metrics are pending, about one burst period); jobs() threads
@@ -199,6 +201,7 @@ class SceneSimulator {
   // (the first pass is skipped; it must be that maximum); on_block: called with every block of
   // the capture, in order, as the receiver's pass reads it (a caller's own scan without a read
   // of its own).
+  static constexpr std::size_t kDecodeFirstBlock = 16384;
   std::vector<Detection> decode_stream(const std::string& family, CaptureSource& src, double period_s = 0,
                                        std::size_t block = std::size_t{1} << 16, std::optional<double> peak = {},
                                        const std::function<void(std::span<const double>)>& on_block = {});
