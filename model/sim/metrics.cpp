@@ -255,10 +255,12 @@ RANGING_CLONE_V4 void lag_norms(const double* s1, const double* s2, std::size_t 
   }
 }
 
-// g_k = o_k inv_den_k for k < lags, and the largest g (max is exact and the products are finite:
-// any order of the maximum gives it, so the AVX-512 clone gives the baseline's bits).
-// Eight running maxima in one vector (the compiler does not vectorize a max reduction itself).
-RANGING_CLONE_V4 double screen_products(const double* o, const double* inv_den, std::size_t lags, double* g) {
+// The screen's g_k = o_k inv_den_k (one IEEE multiply: both functions below compute the same
+// bits, so g is not stored between them).
+// The largest g_k, k < lags (max is exact and the products are finite: any order of the maximum
+// gives it, so the AVX-512 clone gives the baseline's bits). Eight running maxima in one vector
+// (the compiler does not vectorize a max reduction itself).
+RANGING_CLONE_V4 double screen_max(const double* o, const double* inv_den, std::size_t lags) {
   V8 m = V8{} - HUGE_VAL;
   std::size_t k = 0;
   for (; k + 8 <= lags; k += 8) {
@@ -266,32 +268,30 @@ RANGING_CLONE_V4 double screen_products(const double* o, const double* inv_den, 
     std::memcpy(&a, o + k, sizeof a);
     std::memcpy(&b, inv_den + k, sizeof b);
     const V8 p = a * b;
-    std::memcpy(g + k, &p, sizeof p);
     m = m < p ? p : m;  // std::max per lane
   }
   double gmax = -HUGE_VAL;
   for (int u = 0; u < 8; ++u) gmax = std::max(gmax, m[u]);
-  for (; k < lags; ++k) {
-    g[k] = o[k] * inv_den[k];
-    gmax = std::max(gmax, g[k]);
-  }
+  for (; k < lags; ++k) gmax = std::max(gmax, o[k] * inv_den[k]);
   return gmax;
 }
 
 // The indices k < lags with g_k >= lo, in increasing order, into idx; returns how many. Eight
 // lags per compare: a group none of whose lags passes (most) is skipped in one test.
-RANGING_CLONE_V4 std::size_t lags_at_least(const double* g, std::size_t lags, double lo, std::size_t* idx) {
+RANGING_CLONE_V4 std::size_t lags_at_least(const double* o, const double* inv_den, std::size_t lags, double lo,
+                                           std::size_t* idx) {
   std::size_t c = 0, k = 0;
   for (; k + 8 <= lags; k += 8) {
-    V8 a;
-    std::memcpy(&a, g + k, sizeof a);
-    if (!(lanes_max(a) >= lo)) continue;
+    V8 a, b;
+    std::memcpy(&a, o + k, sizeof a);
+    std::memcpy(&b, inv_den + k, sizeof b);
+    if (!(lanes_max(a * b) >= lo)) continue;
     for (std::size_t u = k; u < k + 8; ++u) {
-      if (g[u] >= lo) idx[c++] = u;
+      if (o[u] * inv_den[u] >= lo) idx[c++] = u;
     }
   }
   for (; k < lags; ++k) {
-    if (g[k] >= lo) idx[c++] = k;
+    if (o[k] * inv_den[k] >= lo) idx[c++] = k;
   }
   return c;
 }
@@ -350,7 +350,6 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   std::fill(p.in.begin() + static_cast<std::ptrdiff_t>(w), p.in.end(), 0.0);
   den_.resize(lags);
   inv_den_.resize(lags);
-  g_.resize(lags);
   idx_.resize(lags);
   const double* den = den_.data();
   lag_norms(s1, s2, n_, lags, den_.data(), inv_den_.data());
@@ -377,11 +376,11 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     // of the plain loop, bit for bit. If the largest rho is itself clamped at -1, every lag is.
     const double* o = p.out.data();
     const double g1 = tn / inv_nfft;  // g at rho = 1
-    const double gmax = screen_products(o, inv_den_.data(), lags, g_.data());
+    const double gmax = screen_max(o, inv_den_.data(), lags);
     const double lo = (screen_ && tn > 0 && gmax >= -g1 * (1 - 1e-9))
                           ? std::min(gmax, g1 * (1 - 1e-9)) - (std::abs(gmax) + g1) * 1e-12 - 1e-290
                           : -HUGE_VAL;
-    const std::size_t nk = lags_at_least(g_.data(), lags, lo, idx_.data());
+    const std::size_t nk = lags_at_least(o, inv_den_.data(), lags, lo, idx_.data());
     for (std::size_t c = 0; c < nk; ++c) {
       const std::size_t k = idx_[c];
       double r = 0;
@@ -548,9 +547,12 @@ double kth_smallest(double* m, std::size_t n, std::size_t k, double* buf) {
     constexpr std::size_t kS = 128, kHalf = 12;
     double s[kS];
     for (std::size_t i = 0; i < kS; ++i) s[i] = m[i * n / kS];
-    std::sort(s, s + kS);
+    // the sample's ranks ilo < ihi (the sorted sample's s[ilo], s[ihi]) by two selections
     const std::size_t r = k * kS / n;
-    const double lo = s[r >= kHalf ? r - kHalf : 0], hi = s[std::min(kS - 1, r + kHalf)];
+    const std::size_t ilo = r >= kHalf ? r - kHalf : 0, ihi = std::min(kS - 1, r + kHalf);
+    std::nth_element(s, s + ilo, s + kS);
+    std::nth_element(s + ilo + 1, s + ihi, s + kS);
+    const double lo = s[ilo], hi = s[ihi];
     std::size_t below = 0;
     const std::size_t nb = keep_between(m, n, lo, hi, buf, below);
     if (below <= k && k < below + nb) {

@@ -72,7 +72,7 @@ class PearsonBank {
   std::vector<std::vector<double>> t_;  // centred templates
   std::vector<double> tnorm_;           // sqrt(sum tc^2)
   std::map<std::size_t, std::unique_ptr<Plan>> plans_;
-  AlignedVector<double> s1_, s2_, den_, inv_den_, g_;  // search()'s per-window scratch
+  AlignedVector<double> s1_, s2_, den_, inv_den_;  // search()'s per-window scratch
   std::vector<std::size_t> idx_;
 };
 
@@ -129,8 +129,8 @@ struct StreamDuration {
                                // then any larger hi gives the same result (streaming decode relies on it)
 };
 // The k-th smallest of m[0, n) (k < n; values not NaN; m is reordered): the value
-// std::nth_element leaves at m[k] (duration_td_stream's noise median). For n >= 512 a sorted
-// sample of 128 brackets it, one branchless pass counts the values below the bracket and keeps
+// std::nth_element leaves at m[k] (duration_td_stream's noise median). For n >= 512 two ranks
+// of a sample of 128 (selected, not sorted) bracket it, one branchless pass counts the values below the bracket and keeps
 // those inside (about a fifth) in buf (n entries), and nth_element runs on those only; a
 // bracket that misses the rank falls back to nth_element on all of m.
 double kth_smallest(double* m, std::size_t n, std::size_t k, double* buf);
