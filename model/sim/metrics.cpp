@@ -225,34 +225,72 @@ RANGING_CLONE_V4 void centred_sums(const double* x, std::size_t w, double* in, d
 }
 
 // Per lag k < lags of the window (prefix sums s1, s2 of x - mean): var_k = max(0, S2 - S1^2 / N)
-// over x[k, k + N); then den_k = sqrt(var_k), 0 where the window is flat (var_k <= 1e-24 of the
-// largest, or 0: rho = 0 there), inv_den_k = 1 / den_k (0 there). Every lag on its own, IEEE
-// operations only (divide, sqrt, max), so the AVX-512 clone (picked at load time on a CPU that
-// has it) gives the baseline's bits. metrics.cpp is built with -fno-math-errno, so sqrt is the
-// instruction (and vectorizes); the argument is never negative, errno was never set.
-RANGING_CLONE_V4 void lag_norms(const double* s1, const double* s2, std::size_t n, std::size_t lags, double* den,
-                                double* inv_den) {
+// over x[k, k + N), into var; returns the floor: var_k <= floor (1e-24 of the largest, or 0)
+// means a flat window, den_k = 0 and rho = 0 there; otherwise den_k = sqrt(var_k) (den_of()).
+// Every lag on its own, IEEE operations only (divide, max), so the AVX-512 clone (picked at load
+// time on a CPU that has it) gives the baseline's bits.
+RANGING_CLONE_V4 double lag_variances(const double* s1, const double* s2, std::size_t n, std::size_t lags,
+                                      double* var) {
   const auto nd = static_cast<double>(n);
   for (std::size_t k = 0; k < lags; ++k) {
     const double m1 = s1[k + n] - s1[k];
-    den[k] = std::max(0.0, (s2[k + n] - s2[k]) - m1 * m1 / nd);
+    var[k] = std::max(0.0, (s2[k + n] - s2[k]) - m1 * m1 / nd);
   }
   // the largest variance: max is exact and the variances are not NaN, so any order gives it
   double m8[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   std::size_t k = 0;
   for (; k + 8 <= lags; k += 8) {
-    for (std::size_t u = 0; u < 8; ++u) m8[u] = std::max(m8[u], den[k + u]);
+    for (std::size_t u = 0; u < 8; ++u) m8[u] = std::max(m8[u], var[k + u]);
   }
-  for (; k < lags; ++k) m8[0] = std::max(m8[0], den[k]);
-  double den_max = 0;
-  for (double v : m8) den_max = std::max(den_max, v);
-  const double floor = 1e-24 * den_max;
-  for (k = 0; k < lags; ++k) {
-    const double v = den[k];
-    const double d = v > floor && v > 0 ? std::sqrt(v) : 0.0;
-    den[k] = d;
-    inv_den[k] = d > 0 ? 1.0 / d : 0.0;
+  for (; k < lags; ++k) m8[0] = std::max(m8[0], var[k]);
+  double var_max = 0;
+  for (double v : m8) var_max = std::max(var_max, v);
+  return 1e-24 * var_max;
+}
+
+// den_k from var_k and the floor (metrics.cpp is built with -fno-math-errno, so sqrt is the
+// instruction; the argument is never negative, errno was never set).
+inline double den_of(double v, double floor) { return v > floor && v > 0 ? std::sqrt(v) : 0.0; }
+
+// The screen's inv_den_k, for k < lags: 1 / den_k, 0 where den_k = 0. The screen needs it to
+// about 1e-13 (relative; search()'s margin is 1e-12), never its bits: rho is computed from den_k
+// itself. Baseline: 1.0 / den_k (a sqrt and a divide per lag). AVX-512 (picked once, by the
+// CPU): rsqrt14 (relative error < 2^-14) and two Newton steps y (3 - v y^2) / 2, relative error
+// below 1e-15 for var_k in [1e-290, 1e290] (a group of eight with a lag outside that range takes
+// the baseline's way); the lags at or below the floor get 0 either way.
+void inv_den_scalar(const double* var, std::size_t k0, std::size_t k1, double floor, double* inv) {
+  for (std::size_t k = k0; k < k1; ++k) {
+    const double d = den_of(var[k], floor);
+    inv[k] = d > 0 ? 1.0 / d : 0.0;
   }
+}
+#if defined(__x86_64__)
+[[gnu::target("avx512f")]] void inv_den_avx512(const double* var, std::size_t lags, double floor, double* inv) {
+  const __m512d half = _mm512_set1_pd(0.5), three_halves = _mm512_set1_pd(1.5), fl = _mm512_set1_pd(floor);
+  const __m512d zero = _mm512_setzero_pd(), small = _mm512_set1_pd(1e-290), large = _mm512_set1_pd(1e290);
+  std::size_t k = 0;
+  for (; k + 8 <= lags; k += 8) {
+    const __m512d v = _mm512_loadu_pd(var + k);
+    const __mmask8 on = _mm512_cmp_pd_mask(v, fl, _CMP_GT_OQ) & _mm512_cmp_pd_mask(v, zero, _CMP_GT_OQ);
+    const __mmask8 safe = _mm512_cmp_pd_mask(v, small, _CMP_GE_OQ) & _mm512_cmp_pd_mask(v, large, _CMP_LE_OQ);
+    if ((on & ~safe) != 0) {
+      inv_den_scalar(var, k, k + 8, floor, inv);
+      continue;
+    }
+    const __m512d hv = _mm512_mul_pd(half, v);
+    __m512d y = _mm512_maskz_rsqrt14_pd(0xFF, v);  // (the unmasked form trips GCC 12's -Wmaybe-uninitialized)
+    for (int step = 0; step < 2; ++step) y = _mm512_mul_pd(y, _mm512_fnmadd_pd(_mm512_mul_pd(hv, y), y, three_halves));
+    _mm512_storeu_pd(inv + k, _mm512_maskz_mov_pd(on, y));
+  }
+  inv_den_scalar(var, k, lags, floor, inv);
+}
+#endif
+void inv_den(const double* var, std::size_t lags, double floor, double* inv) {
+#if defined(__x86_64__)
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  if (avx512) return inv_den_avx512(var, lags, floor, inv);
+#endif
+  inv_den_scalar(var, 0, lags, floor, inv);
 }
 
 // The screen's g_k = o_k inv_den_k (one IEEE multiply: both functions below compute the same
@@ -348,11 +386,12 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   const double* s2 = s2_.data();
   centred_sums(xw, w, p.in.data(), s1_.data(), s2_.data());
   std::fill(p.in.begin() + static_cast<std::ptrdiff_t>(w), p.in.end(), 0.0);
-  den_.resize(lags);
+  var_.resize(lags);
   inv_den_.resize(lags);
   idx_.resize(lags);
-  const double* den = den_.data();
-  lag_norms(s1, s2, n_, lags, den_.data(), inv_den_.data());
+  const double* var = var_.data();
+  const double floor = lag_variances(s1, s2, n_, lags, var_.data());
+  inv_den(var, lags, floor, inv_den_.data());
   fftw_execute(p.fwd);
   const std::size_t nc = nfft / 2 + 1;
   // 1/nfft (rounded unless nfft is a power of two: rho's rounding stays a few ulps)
@@ -369,8 +408,9 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     const double tn = tnorm_[j];
     // rho_k = clamp(out_k / nfft / (den_k tn), -1, 1) (0 where den_k = 0), the first lag of the
     // largest wins. A division per lag is most of the search's time, so the lags are screened
-    // first by g_k = out_k / den_k (a multiply: inv_den), which orders them as rho_k does to a
-    // few ulps (rho_k = g_k / (nfft tn) up to rounding), and rho_k is computed exactly as above
+    // first by g_k = out_k / den_k (a multiply: inv_den, itself within 1e-15 of 1 / den_k), which
+    // orders them as rho_k does to a few ulps (rho_k = g_k / (nfft tn) up to rounding and that
+    // 1e-15), and rho_k is computed exactly as above
     // only for the lags that can be the first maximum: g_k within 1e-12 (relative) of the
     // largest g, or (when rho reaches the clamp at 1) of g at rho = 1. So the result is the one
     // of the plain loop, bit for bit. If the largest rho is itself clamped at -1, every lag is.
@@ -384,7 +424,8 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     for (std::size_t c = 0; c < nk; ++c) {
       const std::size_t k = idx_[c];
       double r = 0;
-      if (den[k] > 0 && tn > 0) r = std::clamp(o[k] * inv_nfft / (den[k] * tn), -1.0, 1.0);
+      const double den = den_of(var[k], floor);
+      if (den > 0 && tn > 0) r = std::clamp(o[k] * inv_nfft / (den * tn), -1.0, 1.0);
       if (r > best.rho) best = {r, a + static_cast<long>(k)};
     }
     out.push_back(best);
