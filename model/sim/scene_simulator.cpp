@@ -1184,12 +1184,11 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     bool exact = true;
     // The window: f[base, base + wn) in w[0, wn); w grows (never zero-filled: every sample is the
     // receiver's before it is read) but is not resized per block. Once the samples no longer
-    // needed are at least half of it, the next round moves the rest to the front of w_next (a
-    // copy of at most what is dropped: amortized, under one copy per sample), and the two swap.
-    BufferVector<double> w, w_next;
+    // needed are at least half of it, the rest moves to the front (a copy of at most what is
+    // dropped: amortized, under one copy per sample).
+    BufferVector<double> w;
     std::size_t wn = 0;
     long base = 0, read = 0;
-    std::size_t cut = 0;  // the samples the next round drops from the window's front (0: none)
     auto add_events = [&](const std::vector<Event>& from, std::size_t i0) {
       for (std::size_t i = i0; i < from.size(); ++i) {
         const long st = lk.start_of(from[i]);
@@ -1255,16 +1254,10 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       }
       std::vector<char> done(ready.size(), 0);
       const std::size_t got0 = got.size();
-      // the block's filtered samples go to the window's end; the metrics read what was there. A
-      // round that moves the window (cut > 0) copies the samples it keeps to the front of w_next
-      // (item 0, before its receiver) and the block goes after them there, while the bursts'
-      // metrics read w as it was: the copy runs beside them; w_next is the window after it.
-      const bool move = metrics && cut > 0 && !last;
-      BufferVector<double>& dst = move ? w_next : w;
-      const std::size_t at = move ? w0 - cut : w0;  // the block's place in dst
-      if (metrics && dst.size() < at + k) dst.resize(std::max(at + k, 2 * dst.size()));
+      // the block's filtered samples go to the window's end; the metrics read what was there
+      if (metrics && w.size() < w0 + k) w.resize(std::max(w0 + k, 2 * w.size()));
       const std::span<const double> wr(w.data(), w0);
-      const std::span<double> fk = metrics ? std::span<double>(dst.data() + at, k) : std::span<double>();
+      const std::span<double> fk = metrics ? std::span<double>(w.data() + w0, k) : std::span<double>();
       const std::span<double> xk(x.data(), k);
       std::size_t k_next = 0;
       const std::size_t want_next = std::min(block, 2 * want);
@@ -1275,8 +1268,6 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       parallel_items(first + ready.size(), std::min<std::size_t>(std::max(jobs_, 1), first + ready.size()),
                      [&](std::size_t item, std::size_t t) {
                        if (item == 0) {
-                         if (move) std::copy(w.begin() + static_cast<std::ptrdiff_t>(cut),
-                                             w.begin() + static_cast<std::ptrdiff_t>(w0), w_next.begin());
                          if (last) return rcv.finish(got);
                          if (known && fixed) return;  // the events are known; the filter is item 2
                          if (on_block && !known) on_block(xk);
@@ -1295,12 +1286,6 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       std::size_t r = 0;
       std::erase_if(active, [&](std::size_t i) { return r < ready.size() && ready[r] == i && done[r++]; });
       read += static_cast<long>(k);
-      if (move) {
-        w.swap(w_next);
-        wn = w0 - cut;
-        base += static_cast<long>(cut);
-      }
-      cut = 0;
       if (metrics) wn += k;
       k = k_next;
       if (!known) add_events(got, got0);
@@ -1310,7 +1295,12 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
       long keep = std::min(base + static_cast<long>(wn), std::min(read - lookback, n - 1) - reach);
       for (std::size_t i : active) keep = std::min(keep, needs[i].lo);
       for (std::size_t i : open) keep = std::min(keep, lk.need(n, starts[i]).lo);
-      if (keep > base && static_cast<std::size_t>(keep - base) * 2 >= wn) cut = static_cast<std::size_t>(keep - base);
+      if (keep > base && static_cast<std::size_t>(keep - base) * 2 >= wn) {
+        const auto cut = static_cast<std::size_t>(keep - base);
+        std::copy(w.begin() + static_cast<std::ptrdiff_t>(cut), w.begin() + static_cast<std::ptrdiff_t>(wn), w.begin());
+        wn -= cut;
+        base = keep;
+      }
     }
     if (!known) ev = std::move(got);
     if (!metrics) {  // no metric named: the fields set to NaN
