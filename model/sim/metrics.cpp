@@ -410,10 +410,10 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     // largest wins. A division per lag is most of the search's time, so the lags are screened
     // first by g_k = out_k / den_k (a multiply: inv_den, itself within 1e-15 of 1 / den_k), which
     // orders them as rho_k does to a few ulps (rho_k = g_k / (nfft tn) up to rounding and that
-    // 1e-15), and rho_k is computed exactly as above
-    // only for the lags that can be the first maximum: g_k within 1e-12 (relative) of the
-    // largest g, or (when rho reaches the clamp at 1) of g at rho = 1. So the result is the one
-    // of the plain loop, bit for bit. If the largest rho is itself clamped at -1, every lag is.
+    // 1e-15), and rho_k is computed exactly as above only for the lags that can be the first
+    // maximum: g_k within 1e-12 (relative) of the largest g, or (when rho reaches the clamp at 1)
+    // of g at rho = 1. So the result is the one of the plain loop, bit for bit. If the largest rho
+    // is itself clamped at -1, every lag is.
     const double* o = p.out.data();
     const double g1 = tn / inv_nfft;  // g at rho = 1
     const double gmax = screen_max(o, inv_den_.data(), lags);

@@ -130,9 +130,9 @@ struct StreamDuration {
 };
 // The k-th smallest of m[0, n) (k < n; values not NaN; m is reordered): the value
 // std::nth_element leaves at m[k] (duration_td_stream's noise median). For n >= 512 two ranks
-// of a sample of 128 (selected, not sorted) bracket it, one branchless pass counts the values below the bracket and keeps
-// those inside (about a fifth) in buf (n entries), and nth_element runs on those only; a
-// bracket that misses the rank falls back to nth_element on all of m.
+// of a sample of 128 (selected, not sorted) bracket it, one branchless pass counts the values
+// below the bracket and keeps those inside (about a fifth) in buf (n entries), and nth_element
+// runs on those only; a bracket that misses the rank falls back to nth_element on all of m.
 double kth_smallest(double* m, std::size_t n, std::size_t k, double* buf);
 
 StreamDuration duration_td_stream(std::span<const double> x, std::size_t lo, std::size_t hi, std::size_t p0,
