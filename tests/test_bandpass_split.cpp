@@ -24,7 +24,7 @@ using namespace ranging;
 
 namespace {
 
-constexpr std::size_t kShort = 4093;  // short blocks: below kBandpassSplitMin, never split
+constexpr std::size_t kShort = 4093;  // short blocks: below kBandpassFloatSplitMin, never split
 
 // Bursts of a 200 kHz tone at `amp` (full-scale units) on noise, `quiet` after sample `stop`.
 std::vector<double> signal(std::size_t n, double amp, double noise, std::size_t stop, unsigned seed) {
@@ -166,8 +166,9 @@ TEST(BandpassSplit, AFailingSplitBacksOffThenRetries) {
 }
 
 TEST(BandpassSplit, FloatLongBlockIsThePlainLoopBitForBit) {
+  // The float split's shortest block, the fixed one's, and a longer one.
   const ReceiverDesign d = default_design();
-  const std::size_t n = kBandpassSplitMin + 4321;
+  for (std::size_t n : {kBandpassFloatSplitMin + 999, kBandpassFloatSplitMin + 4321, kBandpassSplitMin + 4321})
   for (double noise : {0.0, 0.01}) {
     const std::vector<double> x = signal(n, 0.4, noise, n - 5000, 6);
     BandpassFloat plain(d.filter), split(d.filter), aliased(d.filter);
@@ -180,21 +181,37 @@ TEST(BandpassSplit, FloatLongBlockIsThePlainLoopBitForBit) {
     split.execute_block(std::span<const double>(x.data(), first), std::span<double>(ys.data(), first));
     split.execute_block(std::span<const double>(x.data() + first, n - first), std::span<double>(ys.data() + first, n - first));
     aliased.execute_block(ya, ya);  // in place: never split (its recomputation needs the input)
-    EXPECT_EQ(std::memcmp(yp.data(), ys.data(), n * sizeof(double)), 0) << "noise " << noise;
-    EXPECT_EQ(std::memcmp(yp.data(), ya.data(), n * sizeof(double)), 0) << "noise " << noise;
+    EXPECT_EQ(std::memcmp(yp.data(), ys.data(), n * sizeof(double)), 0) << "n " << n << " noise " << noise;
+    EXPECT_EQ(std::memcmp(yp.data(), ya.data(), n * sizeof(double)), 0) << "n " << n << " noise " << noise;
     EXPECT_EQ(std::memcmp(plain.section_outputs().data(), split.section_outputs().data(),
                           plain.section_outputs().size() * sizeof(double)),
               0);
     EXPECT_EQ(aliased.split_stats().blocks, 0u);
     if (batch::batch_kernels_available()) {
-      EXPECT_EQ(split.split_stats().blocks, 1u);
+      EXPECT_EQ(split.split_stats().blocks, 1u) << n;  // the first block only (the second is short)
+      // the warm-up is long enough: every lane met the true state (else the split costs time)
+      EXPECT_EQ(split.split_stats().recomputed, 0u) << "n " << n << " noise " << noise;
     }
   }
 }
 
+TEST(BandpassSplit, AFloatBlockShorterThanTheSplitsShortestRunsPlainly) {
+  const ReceiverDesign d = default_design();
+  const std::size_t n = kBandpassFloatSplitMin - 1;
+  const std::vector<double> x = signal(n, 0.4, 0.01, n, 11);
+  BandpassFloat f(d.filter);
+  std::vector<double> y(n);
+  f.execute_block(x, y);
+  EXPECT_EQ(f.split_stats().blocks, 0u);
+  f.execute_block(std::span<const double>(x.data(), n), std::span<double>(y.data(), n));
+  EXPECT_EQ(f.split_stats().blocks, 0u);
+}
+
 TEST(BandpassSplit, ReceiversOnLongBlocksGiveTheShortBlocksEvents) {
   const ReceiverDesign d = default_design();
-  const std::size_t n = 2 * kBandpassSplitMin + 99999;  // one long chunk (2 kBandpassSplitMin) and a short one
+  // one long chunk (2 kBandpassSplitMin), then a shorter one (split by the float filter only)
+  const std::size_t n = 2 * kBandpassSplitMin + 99999;
+  static_assert(99999 >= kBandpassFloatSplitMin && 99999 < kBandpassSplitMin);
   std::vector<double> x(n, 0.0);
   std::mt19937_64 rng(8);
   std::normal_distribution<double> nz(0.0, 0.01);
@@ -222,6 +239,10 @@ TEST(BandpassSplit, ReceiversOnLongBlocksGiveTheShortBlocksEvents) {
     EXPECT_EQ(std::memcmp(&ea[i].score, &eb[i].score, sizeof(double)), 0) << i;
   }
   EXPECT_EQ(std::memcmp(fa.data(), fb.data(), n * sizeof(double)), 0);
+  if (batch::batch_kernels_available()) {
+    EXPECT_EQ(b.filter().split_stats().blocks, 2u);
+    EXPECT_EQ(a.filter().split_stats().blocks, 0u);
+  }
   // fixed: raw events and the overflow counts
   const std::vector<std::int64_t> q = codes(x, d.config.bandpass.input_bits);
   ReceiverFixed c(d), e(d);

@@ -267,22 +267,27 @@ void float_dispatch(const double* in, double* out, std::size_t len, const std::v
 
 // ---- time split: one long block on the SIMD lanes ------------------------------------------
 //
-// A block of n >= kSplitMin samples is cut into kBatchLanes segments that run in lockstep on
+// A block of n >= SplitMin samples is cut into kBatchLanes segments that run in lockstep on
 // the lanes of the SIMD-across-streams kernels (receiver_batch_kernels.hpp, the very arithmetic
 // of the scalar kernels, bit for bit). Lane 0 starts at sample 0 from the filter's state; lane
-// l >= 1 starts kSplitWarmup samples before its segment, from the zero state, and its outputs
+// l >= 1 starts W (the warm-up) samples before its segment, from the zero state, and its outputs
 // count only from the segment's first sample b_l on. The cascade is stable, so the warm-up lane
 // forgets its start: in practice its state at b_l is already, bit for bit, the true one (the
 // state after sample b_l - 1 of the plain run). That is checked, never assumed: the true state
 // at b_l is lane l-1's final state (itself checked), and a lane whose state at b_l differs is
 // recomputed by the scalar kernel from the true state. So the output, the final state and the
 // overflow counts are those of the plain loop in every case; only the time depends on the data.
-// The warm-up costs kSplitWarmup / segment (at most 1/4) of the work.
-constexpr std::size_t kSplitWarmup = 16384;
+// The lanes run W + (n - W) / 8 steps for n samples: the warm-up adds W / segment to their
+// work, at most 1/4 for the fixed cascade (W = 16384, n >= 540672; its lanes must meet the
+// true state on its rounding grid), at most 1 for the float one (W = 8192, n >= 73728: 16384
+// lockstep steps instead of 73728 scalar ones, which pays; measured in docs/results/speed.md).
 constexpr std::size_t kSplitLanes = batch::kBatchLanes;
-constexpr std::size_t kSplitMin = kSplitWarmup + kSplitLanes * 4 * kSplitWarmup;
+constexpr std::size_t kFixedSplitWarmup = 16384;
+constexpr std::size_t kFloatSplitWarmup = 8192;
 constexpr std::size_t kSplitStep = 2048;  // lockstep samples interleaved at a time
-static_assert(kSplitMin == kBandpassSplitMin);
+static_assert(kFixedSplitWarmup + kSplitLanes * 4 * kFixedSplitWarmup == kBandpassSplitMin);
+static_assert(kFloatSplitWarmup + kSplitLanes * kFloatSplitWarmup == kBandpassFloatSplitMin);
+static_assert(kFixedSplitWarmup % kSplitStep == 0 && kFloatSplitWarmup % kSplitStep == 0);
 
 // The states are plain structs of four 64-bit words: equal means the same bits (a -0.0 is not
 // taken for a +0.0, a NaN is itself).
@@ -297,9 +302,9 @@ bool same_state(const std::vector<St>& a, const std::vector<St>& b) {
 // snapshot() (overflow counts at the end of the warm-up), commit(l) (lane l's counts of its
 // own outputs into the filter's counters) and scalar(in, out, m, state) (the plain kernel,
 // counting into the filter's counters). Returns how many lanes were recomputed.
-template <class T, class St, class LaneT, class Ops>
+template <std::size_t W, class T, class St, class LaneT, class Ops>
 std::size_t time_split(const T* in, T* out, std::size_t n, std::vector<St>& state, Ops& ops) {
-  constexpr std::size_t L = kSplitLanes, W = kSplitWarmup;
+  constexpr std::size_t L = kSplitLanes;
   const std::size_t seg = (n - W) / L, steps = W + seg;
   const T* src[L];
   for (std::size_t l = 0; l < L; ++l) src[l] = in + l * seg;  // lane l's first input (b_l - W for l >= 1)
@@ -406,12 +411,12 @@ void BandpassFloat::execute_block(std::span<const double> in, std::span<double> 
     for (std::size_t i = 0; i < in.size(); ++i) out[i] = execute(in[i]);
     return;
   }
-  const bool long_block = in.size() >= kSplitMin &&
+  const bool long_block = in.size() >= kBandpassFloatSplitMin &&
                           !ranges_overlap(in.data(), out.data(), in.size() * sizeof(double)) &&
                           batch::batch_kernels_available();
   const bool split = long_block && try_split(backoff_, split_, [&] {
     FloatSplitOps ops(sections_);
-    return time_split<double, State, batch::LanesF>(in.data(), out.data(), in.size(), state_, ops);
+    return time_split<kFloatSplitWarmup, double, State, batch::LanesF>(in.data(), out.data(), in.size(), state_, ops);
   });
   if (!split) float_dispatch(in.data(), out.data(), in.size(), sections_, state_);
   for (std::size_t k = 0; k < sections_.size(); ++k) out_[k] = state_[k].y1;  // the last sample's
@@ -648,12 +653,12 @@ void BandpassFixed::execute_block(std::span<const std::int64_t> in, std::span<st
   const std::int64_t in_scale = std::int64_t{1} << input_shift_;
   const int qshift = config_.coef_frac;  // acc_frac - data_frac
   const bool long_block = coef_.size() <= static_cast<std::size_t>(batch::kBatchMaxSections) &&
-                          in.size() >= kSplitMin &&
+                          in.size() >= kBandpassSplitMin &&
                           !ranges_overlap(in.data(), out.data(), in.size() * sizeof(std::int64_t)) &&
                           batch::batch_kernels_available();
   if (long_block && try_split(backoff_, split_, [&] {
         FixedSplitOps<State> ops(*this, input_shift_, bias_ok_, section_events_);
-        return time_split<std::int64_t, State, batch::Lanes>(in.data(), out.data(), in.size(), state_, ops);
+        return time_split<kFixedSplitWarmup, std::int64_t, State, batch::Lanes>(in.data(), out.data(), in.size(), state_, ops);
       })) {
     for (std::size_t k = 0; k < state_.size(); ++k) out_[k] = state_[k].y1;
     return;

@@ -254,7 +254,7 @@ std::size_t ReceiverFloat::execute_block(std::span<const double> x, std::vector<
   // Short chunks stay in the cache; a long block is filtered in long chunks, which the
   // bandpass runs on its SIMD lanes (BandpassSplitStats), into `filtered` when given.
   constexpr std::size_t kChunk = 4096;
-  const bool split = x.size() >= kBandpassSplitMin;
+  const bool split = x.size() >= kBandpassFloatSplitMin;
   const std::size_t chunk = split ? std::min(x.size(), 2 * kBandpassSplitMin) : kChunk;
   double y_small[kChunk];
   if (split && filtered.empty()) long_chunk_.resize(chunk);

@@ -116,6 +116,7 @@ class ReceiverFloat {
   std::optional<Event> flush() { return detector_.flush(); }
   double filtered() const { return filtered_; }  // last bandpass output
   const CorrelatorBankFloat& bank() const { return bank_; }
+  const BandpassFloat& filter() const { return filter_; }
 
  private:
   BandpassFloat filter_;
