@@ -283,7 +283,9 @@ TEST(DecodeCli, BadCapturesExitTwoWithAClearMessageAndNoOutput) {
       {"trunc.wav", wav.substr(0, 3000), "--family M1", "trunc.wav: byte 36: truncated"},
       {"family.csv", ok, "--family M9", "option --family: unknown code family 'M9'"},
       {"rate.csv", ok, "--family M1", ""},  // sanity: the good file decodes (exit 0 or 1, not 2)
-      {"ext.txt", ok, "--family M1", "unknown capture type"},
+      {"ext.txt", ok, "--family M1", "ext.txt: unknown capture type '.txt'; valid: .csv"},
+      {"noext", ok, "--family M1", "noext: has no file extension; valid: .csv"},
+      {"dir.csv.d", ok, "--family M1", "dir.csv.d: unknown capture type '.d'"},
   };
   for (const auto& k : cases) {
     write(dir + "/" + k.name, k.content);

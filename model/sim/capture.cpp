@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -701,15 +702,21 @@ void merge_capture_sidecar(CaptureMeta& o, const std::string& path) {
   }
 }
 
-Capture read_capture(const std::string& path, const CaptureRead& how) {
-  std::string ext;
-  if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
+bool capture_is_csv(const std::string& path) {
+  // the file name's extension only (a dot in a directory's name is not one)
+  const std::string name = std::filesystem::path(path).filename().string();
+  const auto dot = name.find_last_of('.');
+  std::string ext = dot == std::string::npos ? std::string() : name.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
-  if (ext != "csv" && ext != "wav") {
-    throw InputError(path + ": unknown capture type '." + ext + "'; valid: .csv (oscilloscope export), .wav");
-  }
+  if (ext == "csv" || ext == "wav") return ext == "csv";
+  const std::string what = dot == std::string::npos ? "has no file extension" : "unknown capture type '." + ext + "'";
+  throw InputError(path + ": " + what + "; valid: .csv (oscilloscope export), .wav");
+}
+
+Capture read_capture(const std::string& path, const CaptureRead& how) {
+  const bool csv = capture_is_csv(path);
   const std::string bytes = read_input_file(path, "capture file", std::size_t{1} << 30);
-  Capture c = ext == "csv" ? parse_capture_csv(bytes, path, how) : parse_capture_wav(bytes, path, how);
+  Capture c = csv ? parse_capture_csv(bytes, path, how) : parse_capture_wav(bytes, path, how);
   merge_capture_sidecar(c.meta, path);
   return c;
 }

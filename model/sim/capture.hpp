@@ -79,6 +79,9 @@ CaptureMeta parse_capture_meta_json(const std::string& text, const std::string& 
 // one the file does not have is an InputError naming the file, the line (CSV) or byte (WAV),
 // and the valid range.
 Capture read_capture(const std::string& path, const CaptureRead& how = {});
+// The capture type by the file name's extension (case-insensitive): true for .csv, false for
+// .wav; anything else, or no extension, is an InputError naming the path and the valid ones.
+bool capture_is_csv(const std::string& path);
 Capture parse_capture_csv(const std::string& text, const std::string& origin, const CaptureRead& how = {});
 Capture parse_capture_wav(const std::string& bytes, const std::string& origin, const CaptureRead& how = {});
 

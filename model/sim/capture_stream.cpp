@@ -141,13 +141,7 @@ CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, co
 CaptureSource::CaptureSource(const std::string& path, const CaptureRead& how, const PartScan& part_scan,
                              std::size_t parts, Deferred)
     : path_(path) {
-  std::string ext;
-  if (const auto dot = path.find_last_of('.'); dot != std::string::npos) ext = path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
-  if (ext != "csv" && ext != "wav") {
-    throw InputError(path + ": unknown capture type '." + ext + "'; valid: .csv (oscilloscope export), .wav");
-  }
-  csv_ = ext == "csv";
+  csv_ = capture_is_csv(path);
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) {
