@@ -1134,7 +1134,8 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
                                                      std::size_t block, std::optional<double> known_peak,
                                                      const std::function<void(std::span<const double>)>& on_block) {
   Link& lk = link(family);
-  block = std::max<std::size_t>(block, 1);
+  // no buffer longer than the capture (its pages would be faulted in for nothing)
+  block = std::clamp<std::size_t>(src.size(), 1, std::max<std::size_t>(block, 1));
   std::vector<double> x(block);
   // Pass 1: the peak (the receiver sees the capture at half full scale at its peak).
   double peak = 0;
