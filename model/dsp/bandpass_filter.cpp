@@ -267,17 +267,17 @@ void float_dispatch(const double* in, double* out, std::size_t len, const std::v
 
 // ---- time split: one long block on the SIMD lanes ------------------------------------------
 //
-// A block of n >= kBandpassSplitMin (fixed) or kBandpassFloatSplitMin (float) samples is cut
-// into kBatchLanes segments that run in lockstep on the lanes of the SIMD-across-streams
-// kernels (receiver_batch_kernels.hpp, the very arithmetic of the scalar kernels, bit for bit).
-// Lane 0 starts at sample 0 from the filter's state; lane l >= 1 starts W (the warm-up) samples
-// before its segment, from the zero state, and its outputs count only from the segment's first
-// sample b_l on. The cascade is stable, so the warm-up lane
-// forgets its start: in practice its state at b_l is already, bit for bit, the true one (the
-// state after sample b_l - 1 of the plain run). That is checked, never assumed: the true state
-// at b_l is lane l-1's final state (itself checked), and a lane whose state at b_l differs is
-// recomputed by the scalar kernel from the true state. So the output, the final state and the
-// overflow counts are those of the plain loop in every case; only the time depends on the data.
+// A block of n >= kBandpassSplitMin (fixed) or kBandpassFloatSplitMin (float) samples is cut into
+// kBatchLanes segments that run in lockstep on the lanes of the SIMD-across-streams kernels
+// (receiver_batch_kernels.hpp, the very arithmetic of the scalar kernels, bit for bit). Lane 0
+// starts at sample 0 from the filter's state; lane l >= 1 starts W (the warm-up) samples before
+// its segment, from the zero state, and its outputs count only from the segment's first sample
+// b_l on. The cascade is stable, so the warm-up lane forgets its start: in practice its state at
+// b_l is already, bit for bit, the true one (the state after sample b_l - 1 of the plain run).
+// That is checked, never assumed: the true state at b_l is lane l-1's final state (itself
+// checked), and a lane whose state at b_l differs is recomputed by the scalar kernel from the
+// true state. So the output, the final state and the overflow counts are those of the plain loop
+// in every case; only the time depends on the data.
 // The lanes run W + (n - W) / 8 steps for n samples: the warm-up adds W / segment to their
 // work, at most 1/4 for the fixed cascade (W = 16384, n >= 540672; its lanes must meet the
 // true state on its rounding grid), at most 1 for the float one (W = 8192, n >= 73728: 16384
