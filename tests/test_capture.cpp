@@ -690,6 +690,18 @@ TEST(Capture, RandomCsvNumbersAreReadExactlyAsStrtodReadsThem) {
     std::snprintf(buf, sizeof buf, fmt[rng() % 4], prec, v);
     cells.emplace_back(buf);
   }
+  // A scope's %.9e (read in one go when its exponent has two digits): decimal exponents -120..120,
+  // so every side of the fast path's |k| <= 22 (exponents -13..31) and three-digit exponents.
+  for (int i = 0; i < 20000; ++i) {
+    const double v = std::uniform_real_distribution<double>(1.0, 10.0)(rng) *
+                     std::pow(10.0, std::uniform_int_distribution<int>(-120, 120)(rng));
+    std::snprintf(buf, sizeof buf, (rng() & 1) ? "%.9e" : "%.9E", (rng() & 1) ? -v : v);
+    cells.emplace_back(buf);
+  }
+  for (const char* edge : {"0.000000000e+00", "-0.000000000e+00", "9.999999999e+31", "9.999999999e+32", "1.000000000e-13",
+                           "1.000000000e-14", "9.007199254e+15", "1.234567890e+05", "1.234567890e+5", "1.234567890e+051"}) {
+    cells.emplace_back(edge);
+  }
   std::string text;
   for (std::size_t n = 0; n < cells.size(); ++n) text += std::to_string(n) + "," + cells[n] + "\n";
   const Capture c = parse_capture_csv(text, "r.csv", {});

@@ -79,6 +79,20 @@ bool fast_decimal(const char* p, const char* end, double& v, const char*& stop) 
   std::uint64_t m = 0, m8 = 0;  // m wraps (unsigned) past 19 digits, which are refused below
   int digits = 0, k = 0;
   if (!digit(q)) return false;
+  // A scope's %.9e cell, d.ddddddddde(+|-)dd not followed by a digit, read in one go: the
+  // m and k the loops below would read (m < 10^10, k = +-dd - 9), so the same value.
+  if (end - q >= 15 && q[1] == '.' && eight_digits(q + 2, m8) && digit(q + 10) && (q[11] == 'e' || q[11] == 'E') &&
+      (q[12] == '-' || q[12] == '+') && digit(q + 13) && digit(q + 14) && !digit(q + 15)) {
+    m = (static_cast<std::uint64_t>(*q - '0') * 100000000 + m8) * 10 + static_cast<unsigned>(q[10] - '0');
+    const int e = 10 * (q[13] - '0') + (q[14] - '0');
+    k = (q[12] == '-' ? -e : e) - 9;
+    if (k < -22 || k > 22) return false;
+    const double a = static_cast<double>(m);
+    v = k < 0 ? a / kPow10[-k] : a * kPow10[k];
+    if (neg) v = -v;
+    stop = q + 15;
+    return true;
+  }
   for (; end - q >= 8 && eight_digits(q, m8); q += 8, digits += 8) m = 100000000 * m + m8;
   for (; digit(q); ++q, ++digits) m = 10 * m + static_cast<unsigned>(*q - '0');
   if (q != end && *q == '.') {
