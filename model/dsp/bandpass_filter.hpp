@@ -71,16 +71,16 @@ struct BandpassHeadroom {
 BandpassHeadroom bandpass_headroom(const BandpassFixedConfig& config, const SosFilter& filter);
 
 // Long blocks (when the CPU has AVX-512: fixed >= 540672 samples, float >= 73728) run as 8
-// segments in lockstep on SIMD lanes, each lane after the first starting a warm-up early from
-// the zero state (fixed 16384 samples, float 8192); a lane whose state at its segment's start
-// is not bit for bit the true one is recomputed by the scalar kernel (bandpass_filter.cpp,
-// "time split"). The float cascade's lanes meet the true state sooner (no rounding of the
-// state to a grid, so no limit cycle to meet) and its split pays from shorter blocks on:
-// decode's 128 k-sample blocks (measured: docs/results/speed.md). Noise makes the lanes meet the true state;
-// a noiseless periodic input can keep them an LSB apart for ever, so after a block with 2 or
-// more lanes redone the filter runs the next long blocks plainly (1, 2, 4 .. 64 of them, the
-// count doubling while the split keeps failing). Results never depend on any of it; the counts
-// say how often it ran, how often a lane had to be redone and how many blocks backed off.
+// segments in lockstep on SIMD lanes, each lane after the first starting a warm-up early from the
+// zero state (fixed 16384 samples, float 8192); a lane whose state at its segment's start is not
+// bit for bit the true one is recomputed by the scalar kernel (bandpass_filter.cpp, "time
+// split"). The float cascade's lanes meet the true state sooner (no rounding of the state to a
+// grid, so no limit cycle to meet) and its split pays from shorter blocks on: decode's 128
+// k-sample blocks (measured: docs/results/speed.md). Noise makes the lanes meet the true state; a
+// noiseless periodic input can keep them an LSB apart for ever, so after a block with 2 or more
+// lanes redone the filter runs the next long blocks plainly (1, 2, 4 .. 64 of them, the count
+// doubling while the split keeps failing). Results never depend on any of it; the counts say how
+// often it ran, how often a lane had to be redone and how many blocks backed off.
 inline constexpr std::size_t kBandpassSplitMin = 540672;  // BandpassFixed's shortest block split (16384 + 8 * 65536)
 inline constexpr std::size_t kBandpassFloatSplitMin = 73728;  // BandpassFloat's (8192 + 8 * 8192)
 struct BandpassSplitStats {

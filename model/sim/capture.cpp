@@ -80,37 +80,33 @@ bool fast_decimal(const char* p, const char* end, double& v, const char*& stop) 
   int digits = 0, k = 0;
   if (!digit(q)) return false;
   // A scope's %.9e cell, d.ddddddddde(+|-)dd not followed by a digit, read in one go: the
-  // m and k the loops below would read (m < 10^10, k = +-dd - 9), so the same value.
+  // m and k the digit loops (else) would read (m < 10^10, k = +-dd - 9), so the same value.
   if (end - q >= 15 && q[1] == '.' && eight_digits(q + 2, m8) && digit(q + 10) && (q[11] == 'e' || q[11] == 'E') &&
       (q[12] == '-' || q[12] == '+') && digit(q + 13) && digit(q + 14) && !digit(q + 15)) {
     m = (static_cast<std::uint64_t>(*q - '0') * 100000000 + m8) * 10 + static_cast<unsigned>(q[10] - '0');
     const int e = 10 * (q[13] - '0') + (q[14] - '0');
     k = (q[12] == '-' ? -e : e) - 9;
-    if (k < -22 || k > 22) return false;
-    const double a = static_cast<double>(m);
-    v = k < 0 ? a / kPow10[-k] : a * kPow10[k];
-    if (neg) v = -v;
-    stop = q + 15;
-    return true;
-  }
-  for (; end - q >= 8 && eight_digits(q, m8); q += 8, digits += 8) m = 100000000 * m + m8;
-  for (; digit(q); ++q, ++digits) m = 10 * m + static_cast<unsigned>(*q - '0');
-  if (q != end && *q == '.') {
-    if (!digit(++q)) return false;
-    for (; end - q >= 8 && eight_digits(q, m8); q += 8, digits += 8, k -= 8) m = 100000000 * m + m8;
-    for (; digit(q); ++q, ++digits, --k) m = 10 * m + static_cast<unsigned>(*q - '0');
-  }
-  if (digits > 19 || m > (std::uint64_t{1} << 53)) return false;
-  if (m == 0 && q != end && (*q == 'x' || *q == 'X')) return false;  // "0x...": strtod reads hex
-  if (q != end && (*q == 'e' || *q == 'E')) {
-    const char* x = q + 1;
-    const bool xneg = x != end && *x == '-';
-    if (x != end && (*x == '-' || *x == '+')) ++x;
-    int e = 0, n = 0;
-    for (; digit(x) && n < 4; ++x, ++n) e = 10 * e + (*x - '0');
-    if (n == 0 || n == 4) return false;  // no exponent digits (from_chars stops before the 'e'), or many
-    k += xneg ? -e : e;
-    q = x;
+    q += 15;
+  } else {
+    for (; end - q >= 8 && eight_digits(q, m8); q += 8, digits += 8) m = 100000000 * m + m8;
+    for (; digit(q); ++q, ++digits) m = 10 * m + static_cast<unsigned>(*q - '0');
+    if (q != end && *q == '.') {
+      if (!digit(++q)) return false;
+      for (; end - q >= 8 && eight_digits(q, m8); q += 8, digits += 8, k -= 8) m = 100000000 * m + m8;
+      for (; digit(q); ++q, ++digits, --k) m = 10 * m + static_cast<unsigned>(*q - '0');
+    }
+    if (digits > 19 || m > (std::uint64_t{1} << 53)) return false;
+    if (m == 0 && q != end && (*q == 'x' || *q == 'X')) return false;  // "0x...": strtod reads hex
+    if (q != end && (*q == 'e' || *q == 'E')) {
+      const char* x = q + 1;
+      const bool xneg = x != end && *x == '-';
+      if (x != end && (*x == '-' || *x == '+')) ++x;
+      int e = 0, n = 0;
+      for (; digit(x) && n < 4; ++x, ++n) e = 10 * e + (*x - '0');
+      if (n == 0 || n == 4) return false;  // no exponent digits (from_chars stops before the 'e'), or many
+      k += xneg ? -e : e;
+      q = x;
+    }
   }
   if (k < -22 || k > 22) return false;
   const double a = static_cast<double>(m);  // m == 0: +0 or -0 whatever k, as strtod reads it
