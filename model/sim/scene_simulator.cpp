@@ -1134,9 +1134,11 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
                                                      std::size_t block, std::optional<double> known_peak,
                                                      const std::function<void(std::span<const double>)>& on_block) {
   Link& lk = link(family);
-  // no buffer longer than the capture (its pages would be faulted in for nothing)
+  // no buffer longer than the capture (its pages would be faulted in for nothing); the block
+  // buffers are BufferVectors: not zeroed (read() writes them first), and from 1 MiB (131072
+  // samples) on backed by huge pages where the kernel has them (model/base/aligned.hpp)
   block = std::clamp<std::size_t>(src.size(), 1, std::max<std::size_t>(block, 1));
-  std::vector<double> x(block);
+  BufferVector<double> x(block);
   // Pass 1: the peak (the receiver sees the capture at half full scale at its peak).
   double peak = 0;
   if (known_peak) {
@@ -1241,7 +1243,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     // Blocks are read one ahead (item 1 of a round reads the next while item 0 receives this one).
     // The first block is short and each next one twice the last, up to `block`: the first
     // round's receiver runs alone (no burst is ready before it), so it is kept short.
-    std::vector<double> xn(block);
+    BufferVector<double> xn(block);
     src.rewind();
     std::size_t want = std::min(block, kDecodeFirstBlock);
     std::size_t k = src.read(std::span<double>(x.data(), want));
