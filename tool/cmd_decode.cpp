@@ -290,7 +290,9 @@ int decode_opened(cli::Parser& p, const std::string& path, const CaptureRead& ho
   check_len(cap.size(), path);
   // Long blocks run the bandpass on its SIMD lanes (time split: float from kBandpassFloatSplitMin
   // samples on, fixed from kBandpassSplitMin), but each sample of a block's buffers is fresh
-  // memory once (a page fault per 4 KiB): long blocks pay on long captures only.
+  // memory once (a page fault per 4 KiB, or per 2 MiB where the kernel gives the buffers of
+  // 131072 samples and more huge pages: model/base/aligned.hpp): long blocks pay on long
+  // captures only.
   std::size_t block = block_option.value_or(std::size_t{1} << 16);
   while (!block_option && block < (std::size_t{1} << 20) && 2 * block <= cap.size() / 64) block *= 2;
   SceneSimulator sim(scene);
