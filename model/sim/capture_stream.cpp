@@ -32,7 +32,7 @@ std::ifstream& part_stream(std::size_t p, std::ifstream& in, std::ifstream& own,
 std::size_t count_newlines(std::ifstream& in, std::size_t begin, std::size_t end, const std::string& origin) {
   in.clear();
   in.seekg(static_cast<std::streamoff>(begin));
-  std::vector<char> buf(std::min(kWavBlockBytes, end - begin));
+  BufferVector<char> buf(std::min(kWavBlockBytes, end - begin));
   std::size_t n = 0;
   for (std::size_t at = begin; at < end;) {
     const std::size_t want = std::min(buf.size(), end - at);
@@ -70,12 +70,13 @@ class BlockScan {
 
 // The lines of bytes [begin, end) of a file, split as std::getline splits them: at each '\n'
 // (not part of the line; a '\r' before it is), the last one without a '\n' if the range does not
-// end with one. Read through one buffer of 1 MiB (grown for a longer line); a line is a view into
-// it, valid until the next call.
+// end with one. Read through one buffer of 1 MiB (grown for a longer line; a BufferVector: not
+// zeroed, on a huge page where the kernel has them); a line is a view into it, valid until the
+// next call.
 class LineReader {
  public:
   LineReader(std::ifstream& in, std::size_t begin, std::size_t end, const std::string& origin)
-      : in_(in), origin_(origin), buf_(kWavBlockBytes, '\0'), file_(begin), end_(end), offset_(begin) {
+      : in_(in), origin_(origin), buf_(kWavBlockBytes), file_(begin), end_(end), offset_(begin) {
     in_.clear();
     in_.seekg(static_cast<std::streamoff>(begin));
   }
@@ -103,7 +104,7 @@ class LineReader {
  private:
   std::ifstream& in_;
   const std::string& origin_;
-  std::string buf_;
+  BufferVector<char> buf_;
   std::size_t at_ = 0, len_ = 0;         // the unread bytes: buf_[at_, len_)
   std::size_t file_, end_, offset_, line_at_ = 0;  // file_: offset of buf_[len_]
   void take(std::size_t n) {
@@ -272,9 +273,9 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + lines_in[p - 1];
   // A file of at most how.csv_keep_rows rows keeps the pass's values for read() (kept_[n]: row
   // n's), if the prediction holds (each part read as many rows as it has lines).
-  kept_.reset();
+  BufferVector<double>().swap(kept_);
   if (total <= how.csv_keep_rows) {
-    kept_ = std::make_unique_for_overwrite<double[]>(total);
+    kept_.resize(total);  // not zeroed: every row's value is written before read() serves it
     kept_[0] = v0;
   }
   // Each part's rows through a continuation of the scan; an error marks the part bad.
@@ -296,7 +297,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
         return;
       }
       if (dt_guess > 0 && !CsvCaptureScan::on_grid(t_first, dt_guess, n, tp)) off_grid[p] = 1;
-      if (kept_ && n < total) kept_[n] = vp;
+      if (n < kept_.size()) kept_[n] = vp;
       blocks.push(vp);
     }
     blocks.flush();
@@ -314,7 +315,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   }
   bool as_predicted = ok && rows.rows() == total;  // every part read as many rows as it has lines
   for (std::size_t p = 0; as_predicted && p < np; ++p) as_predicted = part[p].rows() == lines_in[p];
-  if (!as_predicted) kept_.reset();
+  if (!as_predicted) BufferVector<double>().swap(kept_);
   const bool grid_checked = as_predicted && dt_guess > 0 && rows.step() == dt_guess &&
                             std::find(off_grid.begin(), off_grid.end(), 1) == off_grid.end();
   if (ok && rows.has_time() && !grid_checked) {
@@ -394,7 +395,7 @@ void CaptureSource::seek_start() {
   in_.clear();
   pos_ = 0;
   if (csv_) {
-    if (!kept_) lines_ = std::make_unique<LineReader>(in_, data_at_, file_size_, path_);
+    if (kept_.empty()) lines_ = std::make_unique<LineReader>(in_, data_at_, file_size_, path_);
   } else {
     in_.seekg(static_cast<std::streamoff>(wav_.body));
   }
@@ -403,9 +404,9 @@ void CaptureSource::seek_start() {
 std::size_t CaptureSource::read(std::span<double> out) {
   if (!finished_) throw std::logic_error("CaptureSource: read() before finish()");
   std::size_t k = 0;
-  if (csv_ && kept_) {
+  if (csv_ && !kept_.empty()) {
     const std::size_t want = std::min(out.size(), n_ - pos_);
-    std::copy_n(kept_.get() + pos_, want, out.data());
+    std::copy_n(kept_.data() + pos_, want, out.data());
     pos_ += want;
     return want;
   }

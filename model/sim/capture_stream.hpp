@@ -30,6 +30,7 @@
 #include <string>
 #include <string_view>
 
+#include "model/base/aligned.hpp"
 #include "model/sim/capture.hpp"
 
 namespace ranging {
@@ -182,7 +183,7 @@ class CaptureSource {
   std::unique_ptr<LineReader> lines_;  // CSV: read()'s lines, from the first data row
   // A CSV of at most CaptureRead::csv_keep_rows rows: the open pass's values, which read()
   // then serves instead of reading and parsing the rows again (null: read() parses the rows).
-  std::unique_ptr<double[]> kept_;
+  BufferVector<double> kept_;  // (a BufferVector: not zeroed, on huge pages where the kernel has them)
   std::string buf_;
   PartScan pending_scan_;            // Deferred: finish()'s scan
   std::size_t pending_parts_ = 1;
