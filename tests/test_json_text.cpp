@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -19,6 +20,8 @@
 namespace {
 
 using ranging::tool::json_array_text;
+using ranging::tool::json_splice;
+using ranging::tool::JsonArrayText;
 using ranging::tool::JsonObjectText;
 
 // A member: an integer or a double.
@@ -129,15 +132,37 @@ TEST(JsonText, AnArrayInADocumentIsDumpsText) {
       const std::string mark = "\"\\u0001\"";
       const std::size_t at = text.find(mark);
       ASSERT_NE(at, std::string::npos);
-      text.replace(at, mark.size(), json_array_text(v, write, 1, jobs));
+      const JsonArrayText a = json_array_text(v, write, 1, jobs);
+      std::ostringstream spliced;  // the same document written piece by piece
+      json_splice(spliced, text, {{mark, &a}});
+      text.replace(at, mark.size(), a.str());
       EXPECT_EQ(text, whole.dump(2)) << count << " elements, jobs " << jobs;
+      EXPECT_EQ(spliced.str(), text) << count << " elements, jobs " << jobs;
     }
     // one level deeper: the array as a member of an object that is itself a member
     nlohmann::json inner = {{"outer", {{"list", whole["list"]}}}};
     std::string text = nlohmann::json({{"outer", {{"list", "\x01"}}}}).dump(2);
-    text.replace(text.find("\"\\u0001\""), 8, json_array_text(v, write, 2, 2));
+    text.replace(text.find("\"\\u0001\""), 8, json_array_text(v, write, 2, 2).str());
     EXPECT_EQ(text, inner.dump(2)) << count << " elements at depth 2";
   }
+}
+
+TEST(JsonText, SpliceWritesEveryArrayInItsPlace) {
+  // two arrays, their markers in the document in the order opposite to the list's
+  std::mt19937_64 rng(13);
+  std::vector<Object> a, b;
+  for (int i = 0; i < 600; ++i) a.push_back(random_object(rng));
+  for (int i = 0; i < 3; ++i) b.push_back(random_object(rng));
+  nlohmann::json whole = {{"alpha", nlohmann::json::array()}, {"beta", nlohmann::json::array()}, {"mid", 2}};
+  for (const auto& o : a) whole["alpha"].push_back(to_json(o));
+  for (const auto& o : b) whole["beta"].push_back(to_json(o));
+  const std::string doc = nlohmann::json({{"alpha", "\x01" "a"}, {"beta", "\x01" "b"}, {"mid", 2}}).dump(2);
+  const JsonArrayText ta = json_array_text(a, write, 1, 2), tb = json_array_text(b, write, 1, 2);
+  std::ostringstream os;
+  json_splice(os, doc, {{"\"\\u0001b\"", &tb}, {"\"\\u0001a\"", &ta}});
+  EXPECT_EQ(os.str(), whole.dump(2));
+  std::ostringstream none;
+  EXPECT_THROW(json_splice(none, doc, {{"\"\\u0001c\"", &ta}}), std::logic_error);
 }
 
 TEST(JsonText, RefusesKeysOutOfOrderOrNeedingEscapes) {

@@ -389,14 +389,15 @@ int decode_opened(cli::Parser& p, const std::string& path, const CaptureRead& ho
     j["arrivals_before_first_send"] = unsent;  // their tof_s and distance_m are null
     j["input_clipping"] = {{"samples", clip.samples}, {"runs", clip.runs}, {"max", clip.high}, {"min", clip.low},
                            {"rule", "runs of >= 3 consecutive samples at the capture's maximum or minimum"}};
-    std::string text = stamp_build_info(j).dump(2);
-    for (const auto& [key, list] : lists) {
-      const std::string mark = std::string("\"\\u0001") + key + "\\u0001\"";  // as dump() escapes it
-      const std::size_t at = text.find(mark);
-      if (at == std::string::npos) throw std::logic_error(std::string("decode --json: the marker of ") + key + " is missing");
-      text.replace(at, mark.size(), json_array_text(*list, det_text, 1, sim.jobs()));
+    const std::string text = stamp_build_info(j).dump(2);
+    std::vector<JsonArrayText> arrays;
+    for (const auto& [key, list] : lists) arrays.push_back(json_array_text(*list, det_text, 1, sim.jobs()));
+    std::vector<std::pair<std::string, const JsonArrayText*>> splice;
+    for (std::size_t i = 0; i < arrays.size(); ++i) {
+      splice.emplace_back(std::string("\"\\u0001") + lists[i].first + "\\u0001\"", &arrays[i]);  // as dump() escapes it
     }
-    std::cout << text << "\n";
+    json_splice(std::cout, text, splice);
+    std::cout << "\n";
   } else {
     std::fprintf(stderr, "ranging decode: family %s from %s; speed of sound %.6g m/s from %s; period %.6g s from %s%s%s\n",
                  family.c_str(), family_source.c_str(), c.value, c.source.c_str(), period.value,

@@ -14,16 +14,23 @@
 // json_array_text(v, write, depth, jobs): the text of an array whose element i is the object
 // write(o, v[i]) fills, as dump(2) places it as the value of a key at depth `depth` (1: a key of
 // the top-level object); elements are written in chunks on up to `jobs` threads (the text does
-// not depend on jobs).
+// not depend on jobs). It is kept in those chunks (JsonArrayText: str() joins them).
+//
+// json_splice(os, doc, arrays): writes doc (a dump(2) with string values as markers where arrays
+// go) with the first occurrence of each marker replaced by its array's text, piece by piece: a
+// document of megabytes is never assembled in one string (each copy of it is fresh memory, a page
+// fault per 4 KiB). std::logic_error if a marker is missing.
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <charconv>
+#include <ostream>
 #include <cmath>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "model/base/parallel.hpp"
@@ -85,16 +92,30 @@ class JsonObjectText {
   }
 };
 
+struct JsonArrayText {
+  std::vector<std::string> pieces;  // in order: the text is their concatenation
+  std::string str() const {
+    std::size_t n = 0;
+    for (const auto& p : pieces) n += p.size();
+    std::string out;
+    out.reserve(n);
+    for (const auto& p : pieces) out += p;
+    return out;
+  }
+};
+
 template <class T, class Write>
-std::string json_array_text(const std::vector<T>& v, const Write& write, int depth, int jobs) {
-  if (v.empty()) return "[]";
+JsonArrayText json_array_text(const std::vector<T>& v, const Write& write, int depth, int jobs) {
+  if (v.empty()) return {{"[]"}};
   const std::size_t indent = static_cast<std::size_t>(2 * (depth + 1));
   constexpr std::size_t kChunk = 512;
   const std::size_t chunks = (v.size() + kChunk - 1) / kChunk;
-  std::vector<std::string> parts(chunks);
+  JsonArrayText a;
+  a.pieces.resize(chunks + 2);
+  a.pieces.front() = "[";
   parallel_items(chunks, std::min<std::size_t>(static_cast<std::size_t>(std::max(jobs, 1)), chunks),
                  [&](std::size_t c, std::size_t) {
-                   std::string& out = parts[c];
+                   std::string& out = a.pieces[c + 1];
                    for (std::size_t i = c * kChunk; i < std::min(v.size(), (c + 1) * kChunk); ++i) {
                      out += i == 0 ? "\n" : ",\n";
                      out.append(indent, ' ');
@@ -103,16 +124,27 @@ std::string json_array_text(const std::vector<T>& v, const Write& write, int dep
                      o.finish();
                    }
                  });
-  std::size_t total = 0;
-  for (const auto& p : parts) total += p.size();
-  std::string out;
-  out.reserve(total + indent + 4);
-  out += '[';
-  for (const auto& p : parts) out += p;
-  out += '\n';
-  out.append(indent - 2, ' ');
-  out += ']';
-  return out;
+  a.pieces.back() = "\n" + std::string(indent - 2, ' ') + "]";
+  return a;
+}
+
+inline void json_splice(std::ostream& os, std::string_view doc,
+                        const std::vector<std::pair<std::string, const JsonArrayText*>>& arrays) {
+  std::vector<std::pair<std::size_t, std::size_t>> at;  // (position in doc, index in arrays)
+  for (std::size_t i = 0; i < arrays.size(); ++i) {
+    const std::size_t p = doc.find(arrays[i].first);
+    if (p == std::string_view::npos) throw std::logic_error("json_splice: the marker " + arrays[i].first + " is missing");
+    at.emplace_back(p, i);
+  }
+  std::sort(at.begin(), at.end());
+  std::size_t from = 0;
+  for (const auto& [p, i] : at) {
+    if (p < from) throw std::logic_error("json_splice: the marker " + arrays[i].first + " overlaps another");
+    os.write(doc.data() + from, static_cast<std::streamsize>(p - from));
+    for (const auto& piece : arrays[i].second->pieces) os.write(piece.data(), static_cast<std::streamsize>(piece.size()));
+    from = p + arrays[i].first.size();
+  }
+  os.write(doc.data() + from, static_cast<std::streamsize>(doc.size() - from));
 }
 
 }  // namespace ranging::tool
