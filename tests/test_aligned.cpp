@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <fstream>
+#include <limits>
+#include <new>
 #include <numeric>
 #include <sstream>
 #include <string>
@@ -55,6 +57,13 @@ TEST(Aligned, LargeBlocksStartOnAHugePageAndAreAdvisedHuge) {
   // one byte short of the threshold: the ordinary path
   AlignedVector<char> c(kHugeBufferMin - 1);
   EXPECT_EQ(address(c.data()) % 64, 0u);
+}
+
+TEST(Aligned, ASizeBeyondHalfTheAddressSpaceIsRefused) {
+  // (the rounding up to whole huge pages would otherwise wrap around)
+  AlignedAllocator<double> a;
+  EXPECT_THROW((void)a.allocate(std::numeric_limits<std::size_t>::max() / sizeof(double)), std::bad_array_new_length);
+  EXPECT_THROW((void)a.allocate((std::numeric_limits<std::size_t>::max() >> 1) / sizeof(double)), std::bad_array_new_length);
 }
 
 TEST(Aligned, GrowingAcrossTheThresholdKeepsTheValues) {

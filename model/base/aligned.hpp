@@ -35,7 +35,7 @@ struct AlignedAllocator {
   AlignedAllocator(const AlignedAllocator<U, A>&) {}
   T* allocate(std::size_t n) {
     // (std::vector never asks for more than max_size(); this bound also keeps the rounding finite)
-    if (n > (std::numeric_limits<std::size_t>::max() >> 1) / sizeof(T) - kHugePage) throw std::bad_array_new_length();
+    if (n > ((std::numeric_limits<std::size_t>::max() >> 1) - kHugePage) / sizeof(T)) throw std::bad_array_new_length();
     const std::size_t bytes = n * sizeof(T);
     if (bytes >= kHugeBufferMin) {
       const std::size_t r = (bytes + kHugePage - 1) / kHugePage * kHugePage;
