@@ -390,10 +390,10 @@ int decode_opened(cli::Parser& p, const std::string& path, const CaptureRead& ho
     j["input_clipping"] = {{"samples", clip.samples}, {"runs", clip.runs}, {"max", clip.high}, {"min", clip.low},
                            {"rule", "runs of >= 3 consecutive samples at the capture's maximum or minimum"}};
     const std::string text = stamp_build_info(j).dump(2);
-    std::vector<JsonArrayText> arrays;
-    for (const auto& [key, list] : lists) arrays.push_back(json_array_text(*list, det_text, 1, sim.jobs()));
+    JsonArrayText arrays[std::size(lists)];
     std::vector<std::pair<std::string, const JsonArrayText*>> splice;
-    for (std::size_t i = 0; i < arrays.size(); ++i) {
+    for (std::size_t i = 0; i < std::size(lists); ++i) {
+      arrays[i] = json_array_text(*lists[i].second, det_text, 1, sim.jobs());
       splice.emplace_back(std::string("\"\\u0001") + lists[i].first + "\\u0001\"", &arrays[i]);  // as dump() escapes it
     }
     json_splice(std::cout, text, splice);

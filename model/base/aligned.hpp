@@ -37,7 +37,7 @@ struct AlignedAllocator {
     // (std::vector never asks for more than max_size(); this bound also keeps the rounding finite)
     if (n > ((std::numeric_limits<std::size_t>::max() >> 1) - kHugePage) / sizeof(T)) throw std::bad_array_new_length();
     const std::size_t bytes = n * sizeof(T);
-    if (bytes >= kHugeBufferMin) {
+    if (huge(n)) {
       const std::size_t r = (bytes + kHugePage - 1) / kHugePage * kHugePage;
       void* p = ::operator new(r, std::align_val_t{kHugePage});
       (void)::madvise(p, r, MADV_HUGEPAGE);  // a hint: EINVAL (no THP in this kernel) changes nothing
@@ -46,9 +46,11 @@ struct AlignedAllocator {
     return static_cast<T*>(::operator new(bytes, std::align_val_t{A}));
   }
   void deallocate(T* p, std::size_t n) {
-    if (n * sizeof(T) >= kHugeBufferMin) return ::operator delete(p, std::align_val_t{kHugePage});
+    if (huge(n)) return ::operator delete(p, std::align_val_t{kHugePage});
     ::operator delete(p, std::align_val_t{A});
   }
+  // a block of n elements takes the huge-page path (allocate and deallocate decide alike)
+  static bool huge(std::size_t n) { return n * sizeof(T) >= kHugeBufferMin; }
   template <class U>
   bool operator==(const AlignedAllocator<U, A>&) const {
     return true;

@@ -273,7 +273,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   for (std::size_t p = 1; p < np; ++p) n0[p] = n0[p - 1] + lines_in[p - 1];
   // A file of at most how.csv_keep_rows rows keeps the pass's values for read() (kept_[n]: row
   // n's), if the prediction holds (each part read as many rows as it has lines).
-  BufferVector<double>().swap(kept_);
+  kept_ = {};
   if (total <= how.csv_keep_rows) {
     kept_.resize(total);  // not zeroed: every row's value is written before read() serves it
     kept_[0] = v0;
@@ -315,7 +315,7 @@ void CaptureSource::csv_parts(const CaptureRead& how, const PartScan& scan, std:
   }
   bool as_predicted = ok && rows.rows() == total;  // every part read as many rows as it has lines
   for (std::size_t p = 0; as_predicted && p < np; ++p) as_predicted = part[p].rows() == lines_in[p];
-  if (!as_predicted) BufferVector<double>().swap(kept_);
+  if (!as_predicted) kept_ = {};
   const bool grid_checked = as_predicted && dt_guess > 0 && rows.step() == dt_guess &&
                             std::find(off_grid.begin(), off_grid.end(), 1) == off_grid.end();
   if (ok && rows.has_time() && !grid_checked) {
