@@ -294,42 +294,53 @@ void inv_den(const double* var, std::size_t lags, double floor, double* inv) {
 }
 
 // The screen's g_k = o_k inv_den_k (one IEEE multiply: both functions below compute the same
-// bits, so g is not stored between them).
-// The largest g_k, k < lags (max is exact and the products are finite: any order of the maximum
-// gives it, so the AVX-512 clone gives the baseline's bits). Eight running maxima in one vector
-// (the compiler does not vectorize a max reduction itself).
-RANGING_CLONE_V4 double screen_max(const double* o, const double* inv_den, std::size_t lags) {
+// bits, so g is not stored between them), in blocks of kScreenBlock = 64 lags.
+// screen_max: the largest g_k, k < lags, and per block b its lanes' maxima bm[8 b, 8 b + 8) (lane
+// u: the largest g_k of the block with k = u mod 8; a last partial block's scalar maximum in lane
+// 0, the other lanes -inf). max is exact and the products are finite, so any order of the maximum
+// gives the same bits (the AVX-512 clone, the baseline). bm holds 8 ceil(lags / 64) entries.
+constexpr std::size_t kScreenBlock = 64;
+RANGING_CLONE_V4 double screen_max(const double* o, const double* inv_den, std::size_t lags, double* bm) {
   V8 m = V8{} - HUGE_VAL;
-  std::size_t k = 0;
-  for (; k + 8 <= lags; k += 8) {
-    V8 a, b;
-    std::memcpy(&a, o + k, sizeof a);
-    std::memcpy(&b, inv_den + k, sizeof b);
-    const V8 p = a * b;
-    m = m < p ? p : m;  // std::max per lane
+  std::size_t k = 0, b = 0;
+  for (; k + kScreenBlock <= lags; k += kScreenBlock, ++b) {
+    V8 mb = V8{} - HUGE_VAL;
+    for (std::size_t u = 0; u < kScreenBlock; u += 8) {
+      V8 a, c;
+      std::memcpy(&a, o + k + u, sizeof a);
+      std::memcpy(&c, inv_den + k + u, sizeof c);
+      const V8 p = a * c;
+      mb = mb < p ? p : mb;  // std::max per lane
+    }
+    std::memcpy(bm + 8 * b, &mb, sizeof mb);
+    m = m < mb ? mb : m;
   }
-  double gmax = -HUGE_VAL;
-  for (int u = 0; u < 8; ++u) gmax = std::max(gmax, m[u]);
-  for (; k < lags; ++k) gmax = std::max(gmax, o[k] * inv_den[k]);
+  double gmax = lanes_max(m);
+  if (k < lags) {
+    double t = -HUGE_VAL;
+    for (; k < lags; ++k) t = std::max(t, o[k] * inv_den[k]);
+    V8 mb = V8{} - HUGE_VAL;
+    mb[0] = t;
+    std::memcpy(bm + 8 * b, &mb, sizeof mb);
+    gmax = std::max(gmax, t);
+  }
   return gmax;
 }
 
-// The indices k < lags with g_k >= lo, in increasing order, into idx; returns how many. Eight
-// lags per compare: a group none of whose lags passes (most) is skipped in one test.
+// The indices k < lags with g_k >= lo, in increasing order, into idx; returns how many. A block
+// whose maxima bm (screen_max's) are all below lo (most: only lags near the peak pass) is skipped
+// in one test; the others are read lag by lag.
 RANGING_CLONE_V4 std::size_t lags_at_least(const double* o, const double* inv_den, std::size_t lags, double lo,
-                                           std::size_t* idx) {
-  std::size_t c = 0, k = 0;
-  for (; k + 8 <= lags; k += 8) {
-    V8 a, b;
-    std::memcpy(&a, o + k, sizeof a);
-    std::memcpy(&b, inv_den + k, sizeof b);
-    if (!(lanes_max(a * b) >= lo)) continue;
-    for (std::size_t u = k; u < k + 8; ++u) {
+                                           const double* bm, std::size_t* idx) {
+  std::size_t c = 0;
+  for (std::size_t k = 0, b = 0; k < lags; k += kScreenBlock, ++b) {
+    V8 mb;
+    std::memcpy(&mb, bm + 8 * b, sizeof mb);
+    if (!(lanes_max(mb) >= lo)) continue;
+    const std::size_t end = std::min(lags, k + kScreenBlock);
+    for (std::size_t u = k; u < end; ++u) {
       if (o[u] * inv_den[u] >= lo) idx[c++] = u;
     }
-  }
-  for (; k < lags; ++k) {
-    if (o[k] * inv_den[k] >= lo) idx[c++] = k;
   }
   return c;
 }
@@ -389,6 +400,7 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   var_.resize(lags);
   inv_den_.resize(lags);
   idx_.resize(lags);
+  bm_.resize(8 * ((lags + kScreenBlock - 1) / kScreenBlock));
   const double* var = var_.data();
   const double floor = lag_variances(s1, s2, n_, lags, var_.data());
   inv_den(var, lags, floor, inv_den_.data());
@@ -416,11 +428,11 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
     // is itself clamped at -1, every lag is.
     const double* o = p.out.data();
     const double g1 = tn / inv_nfft;  // g at rho = 1
-    const double gmax = screen_max(o, inv_den_.data(), lags);
+    const double gmax = screen_max(o, inv_den_.data(), lags, bm_.data());
     const double lo = (screen_ && tn > 0 && gmax >= -g1 * (1 - 1e-9))
                           ? std::min(gmax, g1 * (1 - 1e-9)) - (std::abs(gmax) + g1) * 1e-12 - 1e-290
                           : -HUGE_VAL;
-    const std::size_t nk = lags_at_least(o, inv_den_.data(), lags, lo, idx_.data());
+    const std::size_t nk = lags_at_least(o, inv_den_.data(), lags, lo, bm_.data(), idx_.data());
     for (std::size_t c = 0; c < nk; ++c) {
       const std::size_t k = idx_[c];
       double r = 0;

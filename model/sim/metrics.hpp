@@ -72,7 +72,7 @@ class PearsonBank {
   std::vector<std::vector<double>> t_;  // centred templates
   std::vector<double> tnorm_;           // sqrt(sum tc^2)
   std::map<std::size_t, std::unique_ptr<Plan>> plans_;
-  AlignedVector<double> s1_, s2_, var_, inv_den_;  // search()'s per-window scratch
+  AlignedVector<double> s1_, s2_, var_, inv_den_, bm_;  // search()'s per-window scratch
   std::vector<std::size_t> idx_;
 };
 
