@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -144,6 +145,45 @@ TEST(ParallelStreams, FloatPeriodicIsIdenticalWithOneAndTwoThreads) {
   ASSERT_EQ(one.ticks, 12u);  // 3 distances x 2 repeats, per family one train
   expect_same(one, run_all(y, 2));
   expect_same(one, run_all(y, 64));  // more threads than streams
+}
+
+std::string stream_id(const CaptureStream& c) {
+  return std::to_string(c.distance_m) + "/" + std::to_string(c.repeat) + "/" + std::to_string(c.code);
+}
+
+// A capture callback that throws at the k-th stream: with any number of threads the streams
+// before it are emitted (their callbacks and ticks, in stream order), the error comes out of
+// run(), and no later stream is emitted, as with one thread. k = 0, one inside the first group of
+// 8, and one in a later group.
+TEST(ParallelStreams, AFailingCaptureStopsTheRunAfterTheStreamsBeforeIt) {
+  SceneSimulator ref(parse_scene(scene_yaml("float", false), "s.yaml"));
+  for (std::size_t k : {std::size_t{0}, std::size_t{5}, std::size_t{17}}) {
+    for (int jobs : {1, 2, 3}) {
+      SCOPED_TRACE("k " + std::to_string(k) + ", jobs " + std::to_string(jobs));
+      SceneSimulator sim(parse_scene(scene_yaml("float", false), "s.yaml"));
+      sim.set_jobs(jobs);
+      std::vector<std::string> seen;  // the callbacks' streams, in call order
+      std::size_t calls = 0, ticks = 0;
+      try {
+        (void)sim.run(
+            "Gold4", [&] { ++ticks; },
+            [&](const CaptureStream& c) {
+              if (calls++ == k) throw std::runtime_error("disk full");  // once: a later call is recorded
+              seen.push_back(stream_id(c));
+            });
+        ADD_FAILURE() << "run() returned";
+      } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(), "disk full");
+      }
+      EXPECT_EQ(calls, k + 1) << "no stream after the failing one is emitted";
+      EXPECT_EQ(ticks, k);
+      // the same streams as one thread without the failure: 3 distances x 2 repeats x 9 codes
+      std::vector<std::string> all;
+      (void)ref.run("Gold4", nullptr, [&](const CaptureStream& c) { all.push_back(stream_id(c)); });
+      ASSERT_GE(all.size(), k + 1);
+      EXPECT_EQ(seen, std::vector<std::string>(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k)));
+    }
+  }
 }
 
 TEST(ParallelStreams, SimulateWritesTheSameFilesWithJobs) {

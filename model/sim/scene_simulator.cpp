@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <set>
 #include <numbers>
 #include <sstream>
@@ -1085,30 +1086,54 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
     banks.push_back(k == 0 ? nullptr : std::make_unique<PearsonBank>(lk.templates, lk.max_lags()));
     if (batched) rbs.push_back(std::make_unique<Link::Batches>(lk.design));
   }
-  // Units per round (a round's results are held, then emitted in order): several per thread,
-  // so that streams of different lengths balance between the threads.
-  const std::size_t round = jobs <= 1 ? 1 : 8 * jobs;
-  for (std::size_t u0 = 0; u0 < units.size(); u0 += round) {
-    const std::size_t u1 = std::min(units.size(), u0 + round);
-    const std::size_t b0 = units[u0].first, b1 = units[u1 - 1].second;
-    std::vector<StreamOut> outs(b1 - b0);
-    std::vector<std::exception_ptr> errors(b1 - b0);  // per stream: the first in stream order is thrown
-    auto unit = [&](std::size_t u, std::size_t t) {
-      const auto [b, e] = units[u0 + u];
-      run_unit(b, e, t == 0 ? *lk.bank : *banks[t], batched ? rbs[t].get() : nullptr, outs.data() + (b - b0),
-               errors.data() + (b - b0));
-    };
-    if (jobs <= 1) {
-      for (std::size_t u = 0; u < u1 - u0; ++u) unit(u, 0);
-    } else {
-      parallel_items(u1 - u0, jobs, unit);
+  // The units run on the threads, handed out in order; each stream's result is held until every
+  // stream before it is done, then emitted in stream order by one thread at a time (the one that
+  // finds the next unit done; the others go on with their next units meanwhile). No thread waits
+  // for a round's slowest unit, and what is held is about one unit per thread. As with one thread,
+  // the streams before a failing one (its own error, or its emit's: a capture callback that
+  // throws) are emitted, then that error is thrown and no later stream is emitted (units already
+  // started run on; their results are dropped).
+  std::vector<StreamOut> outs(items.size());
+  std::vector<std::exception_ptr> errors(items.size());
+  std::vector<char> unit_done(units.size(), 0);
+  std::mutex emit_m;          // guards the four below; emit()'s state is the draining thread's
+  std::size_t next_unit = 0;  // the first unit not yet emitted
+  bool draining = false;      // a thread is emitting
+  std::exception_ptr failed;  // the error that stopped the emission
+  std::atomic<bool> stop{false};
+  auto unit = [&](std::size_t u, std::size_t t) {
+    if (stop) return;
+    const auto [b, e] = units[u];
+    run_unit(b, e, t == 0 ? *lk.bank : *banks[t], batched ? rbs[t].get() : nullptr, outs.data() + b,
+             errors.data() + b);
+    std::unique_lock<std::mutex> lock(emit_m);
+    unit_done[u] = 1;
+    if (draining) return;  // that thread will find this unit done
+    draining = true;
+    while (!failed && next_unit < units.size() && unit_done[next_unit]) {
+      const auto [vb, ve] = units[next_unit];
+      lock.unlock();
+      std::exception_ptr err;
+      for (std::size_t i = vb; i < ve && !err; ++i) {
+        try {
+          if (errors[i]) std::rethrow_exception(errors[i]);
+          emit(outs[i], items[i]);
+          outs[i] = StreamOut{};  // emitted: its memory goes
+        } catch (...) {
+          err = std::current_exception();
+        }
+      }
+      lock.lock();
+      if (err) {
+        failed = err;
+        stop = true;
+      }
+      ++next_unit;
     }
-    for (std::size_t i = b0; i < b1; ++i) {
-      // As with one thread: the streams before a failing one are emitted, then its error.
-      if (errors[i - b0]) std::rethrow_exception(errors[i - b0]);
-      emit(outs[i - b0], items[i]);
-    }
-  }
+    draining = false;
+  };
+  parallel_items(units.size(), jobs, unit);
+  if (failed) std::rethrow_exception(failed);
   if (false_alarms) *false_alarms = fa;
   if (overflows) *overflows = lk.overflows;
   return rows;
