@@ -1159,11 +1159,14 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
                                                      std::size_t block, std::optional<double> known_peak,
                                                      const std::function<void(std::span<const double>)>& on_block) {
   Link& lk = link(family);
-  // no buffer longer than the capture (its pages would be faulted in for nothing); the block
-  // buffers are BufferVectors: not zeroed (read() writes them first), and from 1 MiB (131072
-  // samples) on backed by huge pages where the kernel has them (model/base/aligned.hpp)
+  // no buffer longer than the capture (its pages would be faulted in for nothing); the two block
+  // buffers x (this block) and xn (the next, read ahead) are halves of one BufferVector: not
+  // zeroed (read() writes them first), and from 1 MiB on backed by huge pages where the kernel
+  // has them (model/base/aligned.hpp): at 65536-sample blocks and up, both share whole 2 MiB pages
   block = std::clamp<std::size_t>(src.size(), 1, std::max<std::size_t>(block, 1));
-  BufferVector<double> x(block);
+  const std::size_t stride = (block + 7) / 8 * 8;  // xn starts on a 64-byte boundary too
+  BufferVector<double> xbuf(stride + block);
+  std::span<double> x(xbuf.data(), block), xn(xbuf.data() + stride, block);
   // Pass 1: the peak (the receiver sees the capture at half full scale at its peak).
   double peak = 0;
   if (known_peak) {
@@ -1268,7 +1271,6 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
     // Blocks are read one ahead (item 1 of a round reads the next while item 0 receives this one).
     // The first block is short and each next one twice the last, up to `block`: the first
     // round's receiver runs alone (no burst is ready before it), so it is kept short.
-    BufferVector<double> xn(block);
     src.rewind();
     std::size_t want = std::min(block, kDecodeFirstBlock);
     std::size_t k = src.read(std::span<double>(x.data(), want));
@@ -1308,7 +1310,7 @@ std::vector<Detection> SceneSimulator::decode_stream(const std::string& family, 
                        if (item == 2 && first == 3) return bp.execute_block(xk, fk);
                        done[item - first] = metrics_of(ready[item - first], wr, t);
                      });
-      x.swap(xn);
+      std::swap(x, xn);
       want = want_next;
       // ready is a subsequence of active, in order: one pass drops the finished ones
       std::size_t r = 0;
