@@ -1090,10 +1090,10 @@ std::vector<Measurement> SceneSimulator::run(const std::string& family, const st
   // stream before it is done, then emitted in stream order by one thread at a time (the one that
   // finds the next unit done; the others go on with their next units meanwhile). No thread waits
   // for a round's slowest unit. What is held is the units done after the first one not done
-  // (about one per thread when the units take alike; before, a round of 16). As with one thread,
-  // the streams before a failing one (its own error, or its emit's: a capture callback that
-  // throws) are emitted, then that error is thrown and no later stream is emitted (units already
-  // started run on; their results are dropped).
+  // (about one per thread when the units take alike). As with one thread, the streams before a
+  // failing one (its own error, or its emit's: a capture callback that throws) are emitted, then
+  // that error is thrown and no later stream is emitted (units already started run on; their
+  // results are dropped).
   std::vector<StreamOut> outs(items.size());
   std::vector<std::exception_ptr> errors(items.size());
   std::vector<char> unit_done(units.size(), 0);
