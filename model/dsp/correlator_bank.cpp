@@ -271,19 +271,37 @@ std::size_t CorrelatorBankFloat::front_end(std::span<const double> in, AtOutput&
   int dec_phase = dec_phase_;
   double acc_re = acc_re_, acc_im = acc_im_, energy = energy_;
   std::size_t i = 0;
-  while (i < in.size()) {
-    const double y = in[i++];
-    const double bre = y * lo_cos[b_idx], bim = -y * lo_sin[b_idx];
-    acc_re += bre - b_re[b_idx];
-    acc_im += bim - b_im[b_idx];
-    b_re[b_idx] = bre;
-    b_im[b_idx] = bim;
-    if (++b_idx == period) b_idx = 0;
-    if (++y_idx == window) y_idx = 0;
-    energy += y * y - y2h[y_idx];
-    y2h[y_idx] = y * y;
-    energy = std::max(energy, 0.0);  // running-sum rounding in double
-    if (++dec_phase == decimation) {
+  const std::size_t n = in.size();
+  while (i < n) {
+    // A run of samples with no index wrap and no output inside (the per-sample work of the
+    // loop it replaces, in the same order; the wraps and the output are tested once per run).
+    // (y_idx advances before its use: the run's first energy slot is the one after it.)
+    const std::size_t y0 = y_idx + 1 == window ? 0 : y_idx + 1;
+    const std::size_t run =
+        std::min({n - i, period - b_idx, window - y0, static_cast<std::size_t>(decimation - dec_phase)});
+    const double* x = in.data() + i;
+    const double* lc = lo_cos + b_idx;
+    const double* ls = lo_sin + b_idx;
+    double* br = b_re + b_idx;
+    double* bi = b_im + b_idx;
+    double* yh = y2h + y0;
+    for (std::size_t u = 0; u < run; ++u) {
+      const double y = x[u];
+      const double bre = y * lc[u], bim = -y * ls[u];
+      acc_re += bre - br[u];
+      acc_im += bim - bi[u];
+      br[u] = bre;
+      bi[u] = bim;
+      energy += y * y - yh[u];
+      yh[u] = y * y;
+      energy = std::max(energy, 0.0);  // running-sum rounding in double
+    }
+    i += run;
+    b_idx += run;
+    if (b_idx == period) b_idx = 0;
+    y_idx = y0 + run - 1;
+    dec_phase += static_cast<int>(run);
+    if (dec_phase == decimation) {
       dec_phase = 0;
       if (at_output(i - 1, acc_re, acc_im, energy)) break;
     }
@@ -523,23 +541,36 @@ std::size_t CorrelatorBankFixed::feed(std::span<const std::int64_t> in) {
   std::uint64_t energy = energy_;
   std::size_t i = 0;
   ready_ = false;
-  while (i < in.size()) {
-    const std::int64_t y = in[i++];
-    // 1. mixer: exact product, round half up into the mixer format.
-    mre = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(y * lo_cos[phase], mix_shift, mix_range_, mix_events_);
-    mim = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(-y * lo_sin[phase], mix_shift, mix_range_, mix_events_);
-    // 2. moving sum over one carrier cycle (exact; dec_bits hold it).
-    acc_re += mre - b_re[phase];
-    acc_im += mim - b_im[phase];
-    b_re[phase] = mre;
-    b_im[phase] = mim;
-    if (++phase == period) phase = 0;
-    // 7. energy: running sum of y^2 over the window, exact.
-    if (++y_idx == window) y_idx = 0;
-    const std::uint64_t y2 = static_cast<std::uint64_t>(y * y);
-    energy = energy + y2 - y2h[y_idx];
-    y2h[y_idx] = y2;
-    if (++dec_phase == l.decimation) {
+  const std::size_t n = in.size();
+  while (i < n) {
+    // A run of samples with no index wrap and no output inside (the per-sample work in the
+    // same order; the wraps and the output are tested once per run). y_idx advances before its
+    // use: the run's first energy slot is the one after it.
+    const std::size_t y0 = y_idx + 1 == window ? 0 : y_idx + 1;
+    const std::size_t run = std::min({n - i, static_cast<std::size_t>(period - phase), window - y0,
+                                      static_cast<std::size_t>(l.decimation - dec_phase)});
+    for (std::size_t u = 0; u < run; ++u) {
+      const std::int64_t y = in[i + u];
+      const std::size_t ph = static_cast<std::size_t>(phase) + u;
+      // 1. mixer: exact product, round half up into the mixer format.
+      mre = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(y * lo_cos[ph], mix_shift, mix_range_, mix_events_);
+      mim = fx_quantize_fast<RoundHalfUp, Overflow::Saturate>(-y * lo_sin[ph], mix_shift, mix_range_, mix_events_);
+      // 2. moving sum over one carrier cycle (exact; dec_bits hold it).
+      acc_re += mre - b_re[ph];
+      acc_im += mim - b_im[ph];
+      b_re[ph] = mre;
+      b_im[ph] = mim;
+      // 7. energy: running sum of y^2 over the window, exact.
+      const std::uint64_t y2 = static_cast<std::uint64_t>(y * y);
+      energy = energy + y2 - y2h[y0 + u];
+      y2h[y0 + u] = y2;
+    }
+    i += run;
+    phase += static_cast<int>(run);
+    if (phase == period) phase = 0;
+    y_idx = y0 + run - 1;
+    dec_phase += static_cast<int>(run);
+    if (dec_phase == l.decimation) {
       dec_phase = 0;
       ready_ = true;
       break;
