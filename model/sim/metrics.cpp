@@ -391,11 +391,13 @@ std::vector<LagRho> PearsonBank::search(std::span<const double> x, long lo, long
   Plan& p = plan(nfft);
   const double* xw = x.data() + a;
   // Segment sums of (x - mean) and its square by prefix sums; x - mean is the transform's input.
-  s1_.resize(w + 1);
-  s2_.resize(w + 1);
-  const double* s1 = s1_.data();
-  const double* s2 = s2_.data();
-  centred_sums(xw, w, p.in.data(), s1_.data(), s2_.data());
+  // s[0] 7 entries into the (64-byte aligned) buffers, so that s + 1, where centred_sums stores
+  // its first vector of each chunk, is on a cache line boundary.
+  s1_.resize(w + 8);
+  s2_.resize(w + 8);
+  double* const s1 = s1_.data() + 7;
+  double* const s2 = s2_.data() + 7;
+  centred_sums(xw, w, p.in.data(), s1, s2);
   std::fill(p.in.begin() + static_cast<std::ptrdiff_t>(w), p.in.end(), 0.0);
   var_.resize(lags);
   inv_den_.resize(lags);
