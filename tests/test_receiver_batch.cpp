@@ -14,6 +14,7 @@
 #include <random>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "model/base/error.hpp"
@@ -142,6 +143,23 @@ TEST(ReceiverBatch, MatchesInEveryRoundingAndOverflowModeAndBothMultiplyWidths) 
     }
   }
   EXPECT_GE(overflowed, 4u);
+}
+
+// The bank's weight multiply Q = P w takes a 32 x 32 -> 64 unsigned multiply when P and w fit
+// 32 bits (corr_bits <= 16: P <= 2^(2 corr_bits - 1)), else the full 64-bit one: both against
+// the scalar receiver, at the boundary (16, 17) and beyond, with the loud stream saturating C.
+TEST(ReceiverBatch, TheBanksWeightMultiplyMatchesAtEveryCorrelatorWidth) {
+  // (corr_bits 24 with weight_bits 24 would exceed the layout's 63 bits)
+  const std::pair<int, int> widths[] = {{12, 12}, {12, 24}, {16, 12}, {16, 24}, {17, 12}, {17, 24}, {24, 12}};
+  for (const auto& [corr_bits, weight_bits] : widths) {
+    ReceiverConfig cfg;
+    cfg.correlator.corr_bits = corr_bits;
+    cfg.correlator.weight_bits = weight_bits;
+    const ReceiverDesign d = design_receiver(cfg);
+    const auto streams = make_streams(d, {20000, 20000, 20000, 15000, 20000, 12345, 20000, 20000, 777}, 9);
+    const std::string what = "corr_bits " + std::to_string(corr_bits) + " weight_bits " + std::to_string(weight_bits);
+    expect_same(d, streams, what.c_str());
+  }
 }
 
 // Leading silence at fixed precision: a batch's common leading codes of 0 are skipped in steps

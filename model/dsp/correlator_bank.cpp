@@ -669,6 +669,8 @@ FixedBankLanes::FixedBankLanes(const CorrelatorBankFixed& bank) {
   // taps < 2^(tap_bits-1) <= 2^23; Bd < 2^(dec_bits-1); C_q < 2^(corr_bits-1)
   b.fir_narrow = bank.cfg_.tap_bits <= 32 && l.dec_bits <= 32;
   b.power_narrow = bank.cfg_.corr_bits <= 32;
+  // P < 2^power_bits and 0 <= w < 2^weight_bits
+  b.weight_narrow = l.power_bits <= 32 && bank.cfg_.weight_bits <= 32;
   lo_cos = l.lo_cos;
   for (std::int64_t v : l.lo_sin) lo_nsin.push_back(-v);
   taps_rev = bank.taps_rev_;

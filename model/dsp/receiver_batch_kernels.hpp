@@ -49,6 +49,7 @@ struct BankBatch {
   FxRange mix_range{}, chip_range{}, corr_range{};
   bool fir_narrow = false;    // taps and Bd fit int32
   bool power_narrow = false;  // C_q fits int32
+  bool weight_narrow = false; // P and w fit uint32: Q = P w by a 32 x 32 -> 64 unsigned multiply
   const std::int64_t* lo_cos = nullptr;    // period
   const std::int64_t* lo_nsin = nullptr;   // period: -lo_sin (the mixer's imaginary product)
   const std::int64_t* taps_rev = nullptr;  // taps, reversed

@@ -10,7 +10,8 @@
 // int64 values, with the scalar model's bounds (BandpassFixed: |acc| < 2^63 by acc_bits <= 64;
 // CorrelatorBankFixed: the layout's widths <= 62 bits), so no lane overflows int64. A 32 x 32
 // -> 64 multiply (vpmuldq) is used only where the owner proved both factors fit int32
-// (BandpassBatch::narrow, BankBatch::fir_narrow / power_narrow); otherwise the full 64-bit
+// (BandpassBatch::narrow, BankBatch::fir_narrow / power_narrow; unsigned, vpmuludq, where
+// BankBatch::weight_narrow proved both fit uint32); otherwise the full 64-bit
 // multiply (vpmullq), whose low 64 bits are the exact product under those bounds. Rounding is
 // fx_round_shift's, overflow fx_overflow_slow's (saturate or wrap, counted per lane).
 #include "model/dsp/receiver_batch_kernels.hpp"
@@ -188,7 +189,13 @@ void decimated_output(BankBatch& s) {
     const V cr = quantize_rhu_sat(cre, s.corr_shift, s.corr_range, s.corr_events);
     const V ci = quantize_rhu_sat(cim, s.corr_shift, s.corr_range, s.corr_events);
     const V p = mul<PowerNarrow>(cr, cr) + mul<PowerNarrow>(ci, ci);
-    store(s.q[j], p * splat(s.weights[j]));  // Q = P w: the layout proves it fits 64 bits
+    // Q = P w: the layout proves it fits 64 bits; vpmuludq when both fit 32 (vpmullq is three
+    // micro-ops and 15 cycles on Intel cores)
+    const V w = splat(s.weights[j]);
+    // (the zero-masked form: the plain one trips GCC 12's -Wmaybe-uninitialized in its header)
+    store(s.q[j], s.weight_narrow ? reinterpret_cast<V>(_mm512_maskz_mul_epu32(__mmask8(0xFF), reinterpret_cast<__m512i>(p),
+                                                                                reinterpret_cast<__m512i>(w)))
+                                  : p * w);
   }
 }
 
