@@ -347,10 +347,12 @@ inline void wave_advance(__mmask8 act, T x, T y, T& x1, T& x2, T& y1, T& y2, T (
 
 // The lanes in `bad` brought into range by c.overflow, each counted (out of line: the loop keeps
 // its vectors in registers).
-[[gnu::noinline]] void wave_overflow(V& y, __mmask8 bad, const BandpassBatch& c, OverflowCounter& events) {
+// (y by value and returned: a reference would keep y in memory, stored at every step.)
+[[gnu::noinline]] V wave_overflow(V y, __mmask8 bad, const BandpassBatch& c, OverflowCounter& events) {
   for (int l = 0; l < kBatchLanes; ++l) {
     if ((bad >> l) & 1) y[l] = fx_overflow_slow(y[l], c.range, c.overflow, events);
   }
+  return y;
 }
 
 // The steps [i0, i1) of the wavefront over in[0, n). Masked for the first and last steps: the
@@ -383,8 +385,9 @@ void wave_steps(const BandpassBatch& c, const V (&co)[5], Wave<V>& w, const std:
     const V acc = part - mul<Narrow>(a1, y1);
     V y = Bias ? acc >> qs : round_shift<R>(acc, qs);
     const __m512i yi = reinterpret_cast<__m512i>(y);
-    const __mmask8 bad = _mm512_mask_cmplt_epi64_mask(act, yi, lo) | _mm512_mask_cmpgt_epi64_mask(act, yi, hi);
-    if (bad) [[unlikely]] wave_overflow(y, bad, c, events);
+    const __mmask8 below = _mm512_mask_cmplt_epi64_mask(act, yi, lo), above = _mm512_mask_cmpgt_epi64_mask(act, yi, hi);
+    // (kortest: one micro-op tests both masks; moving them to integer registers took three)
+    if (!_kortestz_mask8_u8(below, above)) [[unlikely]] y = wave_overflow(y, below | above, c, events);
     wave_advance<Masked>(act, x, y, x1, x2, y1, y2, p);
     if (i >= lat) out[i - lat] = lane_of(y, last);  // the last section's sample i - lat
   }
