@@ -8,6 +8,7 @@
 
 #include "model/base/error.hpp"
 #include "model/dsp/bank_lanes.hpp"
+#include "model/dsp/front_end_run.hpp"
 
 namespace ranging {
 namespace {
@@ -273,19 +274,15 @@ std::size_t CorrelatorBankFloat::front_end(std::span<const double> in, AtOutput&
   std::size_t i = 0;
   const std::size_t n = in.size();
   while (i < n) {
-    // A run of samples with no index wrap and no output inside (the per-sample work of the
-    // loop it replaces, in the same order; the wraps and the output are tested once per run).
-    // (y_idx advances before its use: the run's first energy slot is the one after it.)
-    const std::size_t y0 = y_idx + 1 == window ? 0 : y_idx + 1;
-    const std::size_t run =
-        std::min({n - i, period - b_idx, window - y0, static_cast<std::size_t>(decimation - dec_phase)});
+    // a run with no wrap and no output inside (front_end_run.hpp)
+    const FrontEndRun r = front_end_run(n - i, b_idx, period, y_idx, window, dec_phase, decimation);
     const double* x = in.data() + i;
     const double* lc = lo_cos + b_idx;
     const double* ls = lo_sin + b_idx;
     double* br = b_re + b_idx;
     double* bi = b_im + b_idx;
-    double* yh = y2h + y0;
-    for (std::size_t u = 0; u < run; ++u) {
+    double* yh = y2h + r.y0;
+    for (std::size_t u = 0; u < r.len; ++u) {
       const double y = x[u];
       const double bre = y * lc[u], bim = -y * ls[u];
       acc_re += bre - br[u];
@@ -296,13 +293,8 @@ std::size_t CorrelatorBankFloat::front_end(std::span<const double> in, AtOutput&
       yh[u] = y * y;
       energy = std::max(energy, 0.0);  // running-sum rounding in double
     }
-    i += run;
-    b_idx += run;
-    if (b_idx == period) b_idx = 0;
-    y_idx = y0 + run - 1;
-    dec_phase += static_cast<int>(run);
-    if (dec_phase == decimation) {
-      dec_phase = 0;
+    i += r.len;
+    if (front_end_advance(r, b_idx, period, y_idx, dec_phase, decimation)) {
       if (at_output(i - 1, acc_re, acc_im, energy)) break;
     }
   }
@@ -543,13 +535,9 @@ std::size_t CorrelatorBankFixed::feed(std::span<const std::int64_t> in) {
   ready_ = false;
   const std::size_t n = in.size();
   while (i < n) {
-    // A run of samples with no index wrap and no output inside (the per-sample work in the
-    // same order; the wraps and the output are tested once per run). y_idx advances before its
-    // use: the run's first energy slot is the one after it.
-    const std::size_t y0 = y_idx + 1 == window ? 0 : y_idx + 1;
-    const std::size_t run = std::min({n - i, static_cast<std::size_t>(period - phase), window - y0,
-                                      static_cast<std::size_t>(l.decimation - dec_phase)});
-    for (std::size_t u = 0; u < run; ++u) {
+    // a run with no wrap and no output inside (front_end_run.hpp)
+    const FrontEndRun r = front_end_run(n - i, phase, period, y_idx, window, dec_phase, l.decimation);
+    for (std::size_t u = 0; u < r.len; ++u) {
       const std::int64_t y = in[i + u];
       const std::size_t ph = static_cast<std::size_t>(phase) + u;
       // 1. mixer: exact product, round half up into the mixer format.
@@ -562,16 +550,11 @@ std::size_t CorrelatorBankFixed::feed(std::span<const std::int64_t> in) {
       b_im[ph] = mim;
       // 7. energy: running sum of y^2 over the window, exact.
       const std::uint64_t y2 = static_cast<std::uint64_t>(y * y);
-      energy = energy + y2 - y2h[y0 + u];
-      y2h[y0 + u] = y2;
+      energy = energy + y2 - y2h[r.y0 + u];
+      y2h[r.y0 + u] = y2;
     }
-    i += run;
-    phase += static_cast<int>(run);
-    if (phase == period) phase = 0;
-    y_idx = y0 + run - 1;
-    dec_phase += static_cast<int>(run);
-    if (dec_phase == l.decimation) {
-      dec_phase = 0;
+    i += r.len;
+    if (front_end_advance(r, phase, period, y_idx, dec_phase, l.decimation)) {
       ready_ = true;
       break;
     }

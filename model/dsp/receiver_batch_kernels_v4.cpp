@@ -15,10 +15,8 @@
 // multiply (vpmullq), whose low 64 bits are the exact product under those bounds. Rounding is
 // fx_round_shift's, overflow fx_overflow_slow's (saturate or wrap, counted per lane).
 #include "model/dsp/receiver_batch_kernels.hpp"
-
-#include <algorithm>
-
 #include "model/base/transpose8.hpp"
+#include "model/dsp/front_end_run.hpp"
 
 #if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__)
 #include <immintrin.h>
@@ -548,11 +546,9 @@ std::size_t bank_feed_batch_float(FloatBankBatch& s, const LanesF* in, std::size
   std::size_t i = 0;
   *ready = false;
   while (i < n) {
-    // A run with no wrap and no output inside (as bank_feed_batch's)
-    const std::size_t y0 = y_idx + 1 == window ? 0 : y_idx + 1;
-    const std::size_t run =
-        std::min({n - i, period - b_idx, window - y0, static_cast<std::size_t>(decimation - dec_phase)});
-    for (std::size_t u = 0; u < run; ++u) {
+    // a run with no wrap and no output inside (front_end_run.hpp)
+    const FrontEndRun r = front_end_run(n - i, b_idx, period, y_idx, window, dec_phase, decimation);
+    for (std::size_t u = 0; u < r.len; ++u) {
       const D y = loadf(in[i + u]);
       const std::size_t b = b_idx + u;
       const D bre = y * splatf(s.lo_cos[b]), bim = -y * splatf(s.lo_sin[b]);
@@ -560,17 +556,12 @@ std::size_t bank_feed_batch_float(FloatBankBatch& s, const LanesF* in, std::size
       acc_im += bim - loadf(s.b_im[b]);
       storef(s.b_re[b], bre);
       storef(s.b_im[b], bim);
-      energy += y * y - loadf(s.y2h[y0 + u]);
-      storef(s.y2h[y0 + u], y * y);
+      energy += y * y - loadf(s.y2h[r.y0 + u]);
+      storef(s.y2h[r.y0 + u], y * y);
       energy = energy < zero ? zero : energy;  // std::max(energy, 0.0)
     }
-    i += run;
-    b_idx += run;
-    if (b_idx == period) b_idx = 0;
-    y_idx = y0 + run - 1;
-    dec_phase += static_cast<int>(run);
-    if (dec_phase == decimation) {
-      dec_phase = 0;
+    i += r.len;
+    if (front_end_advance(r, b_idx, period, y_idx, dec_phase, decimation)) {
       *ready = true;
       break;
     }
@@ -611,13 +602,9 @@ std::size_t bank_feed_batch(BankBatch& s, const Lanes* in, std::size_t n, bool* 
   std::size_t i = 0;
   *ready = false;
   while (i < n) {
-    // A run of samples with no index wrap and no output inside (the per-sample loop's work in
-    // the same order; the wraps and the output tested once per run). y_idx advances before its
-    // use: the run's first energy slot is the one after it.
-    const std::size_t y0 = y_idx + 1 == window ? 0 : y_idx + 1;
-    const std::size_t run = std::min({n - i, static_cast<std::size_t>(period - phase), window - y0,
-                                      static_cast<std::size_t>(decimation - dec_phase)});
-    for (std::size_t u = 0; u < run; ++u) {
+    // a run with no wrap and no output inside (front_end_run.hpp)
+    const FrontEndRun r = front_end_run(n - i, phase, period, y_idx, window, dec_phase, decimation);
+    for (std::size_t u = 0; u < r.len; ++u) {
       const V y = load(in[i + u]);
       const std::size_t ph = static_cast<std::size_t>(phase) + u;
       // 1. mixer, round half up, saturate (counted)
@@ -630,16 +617,11 @@ std::size_t bank_feed_batch(BankBatch& s, const Lanes* in, std::size_t n, bool* 
       store(s.b_im[ph], mim);
       // 7. energy: running sum of y^2 over the window (uint64 arithmetic: the same bits)
       const V y2 = mul<true>(y, y);
-      energy = energy + y2 - load(s.y2h[y0 + u]);
-      store(s.y2h[y0 + u], y2);
+      energy = energy + y2 - load(s.y2h[r.y0 + u]);
+      store(s.y2h[r.y0 + u], y2);
     }
-    i += run;
-    phase += static_cast<int>(run);
-    if (phase == period) phase = 0;
-    y_idx = y0 + run - 1;
-    dec_phase += static_cast<int>(run);
-    if (dec_phase == decimation) {
-      dec_phase = 0;
+    i += r.len;
+    if (front_end_advance(r, phase, period, y_idx, dec_phase, decimation)) {
       *ready = true;
       break;
     }
